@@ -1,0 +1,31 @@
+"""leas-jax: learning to steer a locomotion contact planner (LeaS) in JAX.
+
+Public API (imported lazily so that `import leas_jax` stays fast and host-only
+users do not pay for JAX start-up):
+
+    from leas_jax import load_terrain, LeasEnv, TrainConfig, train, load_policy, rollout
+"""
+
+import importlib
+
+__version__ = "0.1.0"
+
+_LAZY = {
+    "load_terrain": "leas_jax.terrain",
+    "loads_terrain": "leas_jax.terrain",
+    "Terrain": "leas_jax.terrain",
+    "LeasEnv": "leas_jax.env",
+    "EnvParams": "leas_jax.env",
+    "TrainConfig": "leas_jax.train",
+    "train": "leas_jax.train",
+    "load_policy": "leas_jax.train",
+    "rollout": "leas_jax.steering",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'leas_jax' has no attribute {name!r}")

@@ -1,0 +1,9 @@
+"""Errors shared by the package: the command line turns them into one-line messages."""
+
+
+class LeasError(Exception):
+    """Base class of the errors this package raises on bad input."""
+
+
+class UsageError(LeasError):
+    """Bad command-line or API input; `leas` prints it on one line and exits with code 2."""

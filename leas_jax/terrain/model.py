@@ -1,0 +1,441 @@
+"""Terrain data model: boxes over a void, their heightfield, support surfaces and exports.
+
+Host code (NumPy); nothing here can be jitted. The file format is DESIGN §4 (terrain
+format v1); the interface is docs/architecture.md. All coordinates are world frame,
+metres, z up.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from leas_jax.errors import LeasError
+
+# Boxes are closed sets: a raster point exactly on a box edge belongs to it. Grid
+# coordinates xmin + i*res carry rounding errors of ~1e-15 m, so the slab test
+# accepts points 1e-7 m outside a face; far below the raster resolution.
+_EDGE_TOL = 1e-7  # m
+# Number of raster points evaluated at once per box (bounds the temporary arrays
+# to a few tens of MB whatever the box size).
+_CHUNK_POINTS = 1 << 20
+# A face is buried if a point this far above its centre (along its normal) lies
+# inside another box: a step resting on the ground covers the ground face there.
+_BURIED_PROBE = 1e-3  # m
+
+
+class TerrainError(LeasError):
+    """Invalid terrain file or terrain input; the message names file, key and value."""
+
+
+def _frozen_array(value, shape: tuple[int, ...]) -> np.ndarray:
+    """Copy `value` to a read-only float64 array of the given shape."""
+    array = np.array(value, dtype=np.float64).reshape(shape)
+    array.setflags(write=False)
+    return array
+
+
+def rotation_from_rpy(rpy) -> np.ndarray:
+    """Rotation matrix of roll, pitch, yaw (rad) in the z-y-x convention.
+
+    Args:
+        rpy: [3] (roll, pitch, yaw), rad.
+
+    Returns:
+        [3, 3] world_R_box = Rz(yaw) @ Ry(pitch) @ Rx(roll).
+    """
+    roll, pitch, yaw = (float(a) for a in rpy)
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    return rz @ ry @ rx
+
+
+def quaternion_wxyz_from_rpy(rpy) -> np.ndarray:
+    """Unit quaternion (w, x, y, z), MuJoCo order, of the rotation `rotation_from_rpy(rpy)`.
+
+    Args:
+        rpy: [3] (roll, pitch, yaw), rad.
+
+    Returns:
+        [4] (w, x, y, z) with w >= 0.
+    """
+    roll, pitch, yaw = (0.5 * float(a) for a in rpy)
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    # q = qz(yaw) * qy(pitch) * qx(roll), expanded.
+    q = np.array([
+        cy * cp * cr + sy * sp * sr,
+        cy * cp * sr - sy * sp * cr,
+        cy * sp * cr + sy * cp * sr,
+        sy * cp * cr - cy * sp * sr,
+    ])
+    return q if q[0] >= 0.0 else -q
+
+
+@dataclass(frozen=True, eq=False)
+class Box:
+    """An oriented box of the terrain.
+
+    Attributes:
+        center: [3] centre, world frame, m.
+        size: [3] full extents along the box axes, m (all > 0).
+        rpy: [3] roll, pitch, yaw of the box axes, rad (world_R_box = Rz Ry Rx).
+    """
+
+    center: np.ndarray
+    size: np.ndarray
+    rpy: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self):
+        object.__setattr__(self, "center", _frozen_array(self.center, (3,)))
+        object.__setattr__(self, "size", _frozen_array(self.size, (3,)))
+        object.__setattr__(self, "rpy", _frozen_array(self.rpy, (3,)))
+
+    def __eq__(self, other):
+        if not isinstance(other, Box):
+            return NotImplemented
+        return (np.array_equal(self.center, other.center) and np.array_equal(self.size, other.size)
+                and np.array_equal(self.rpy, other.rpy))
+
+    def __hash__(self):
+        return hash((self.center.tobytes(), self.size.tobytes(), self.rpy.tobytes()))
+
+    @property
+    def half(self) -> np.ndarray:
+        """[3] half extents along the box axes, m."""
+        return 0.5 * self.size
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """[3, 3] world_R_box = Rz(yaw) @ Ry(pitch) @ Rx(roll); columns are the box axes in world."""
+        return rotation_from_rpy(self.rpy)
+
+    @property
+    def quaternion_wxyz(self) -> np.ndarray:
+        """[4] orientation as a (w, x, y, z) quaternion (MuJoCo order)."""
+        return quaternion_wxyz_from_rpy(self.rpy)
+
+    def vertices(self) -> np.ndarray:
+        """[8, 3] corners, world frame; corner k has signs (+/-) of bits (k>>2, k>>1, k) on x, y, z."""
+        signs = np.array([[1 - 2 * ((k >> b) & 1) for b in (2, 1, 0)] for k in range(8)], dtype=np.float64)
+        return self.center + (signs * self.half) @ self.rotation.T
+
+    def aabb(self) -> np.ndarray:
+        """[2, 3] axis-aligned bounds (min row, max row), world frame."""
+        extent = np.abs(self.rotation) @ self.half
+        return np.stack([self.center - extent, self.center + extent])
+
+    def contains(self, points: np.ndarray, tol: float = 0.0) -> np.ndarray:
+        """Whether points lie inside the box grown by `tol`.
+
+        Args:
+            points: [N, 3] world frame.
+            tol: margin added to every half extent, m.
+
+        Returns:
+            [N] bool.
+        """
+        local = (np.asarray(points, dtype=np.float64) - self.center) @ self.rotation
+        return np.all(np.abs(local) <= self.half + tol, axis=-1)
+
+    def column_top(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Highest point of the box on vertical lines, by slab intersection.
+
+        The vertical line through (x, y) is p(z) = (x, y, z). In the box frame it is
+        o + z d with o = R^T ((x, y, 0) - c) and d = R^T e_z (the third row of R). It
+        meets the box where |o_k + z d_k| <= h_k for the three axes k: each axis with
+        d_k != 0 bounds z to [(-h_k - o_k)/d_k, (h_k - o_k)/d_k] (sorted); an axis with
+        d_k = 0 (a vertical face) either holds for every z or for none.
+
+        Args:
+            x: [...] world x, m.
+            y: [...] same shape, world y, m.
+
+        Returns:
+            [...] top z of the intersection, -inf where the line misses the box.
+        """
+        rot = self.rotation
+        dx = np.asarray(x, dtype=np.float64) - self.center[0]
+        dy = np.asarray(y, dtype=np.float64) - self.center[1]
+        # The hit test uses the box grown by _EDGE_TOL (closed set, robust to rounding);
+        # the returned height uses the true box so that it is exact.
+        lower = np.full(dx.shape, -np.inf)
+        upper = np.full(dx.shape, np.inf)
+        top = np.full(dx.shape, np.inf)
+        for k in range(3):
+            d_k = rot[2, k]
+            o_k = rot[0, k] * dx + rot[1, k] * dy - rot[2, k] * self.center[2]
+            if abs(d_k) < 1e-12:
+                upper = np.where(np.abs(o_k) > self.half[k] + _EDGE_TOL, -np.inf, upper)
+                continue
+            a = (-self.half[k] - _EDGE_TOL - o_k) / d_k
+            b = (self.half[k] + _EDGE_TOL - o_k) / d_k
+            lower = np.maximum(lower, np.minimum(a, b))
+            upper = np.minimum(upper, np.maximum(a, b))
+            top = np.minimum(top, (np.sign(d_k) * self.half[k] - o_k) / d_k)
+        return np.where(lower <= upper, top, -np.inf)
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """Evaluation scenario of a terrain (DESIGN §4 `[scenario]`).
+
+    Attributes:
+        target: [2] goal (x, y), world frame, m; z comes from the terrain.
+        start_region: [2, 2] [[xmin, ymin], [xmax, ymax]] of the start positions, m.
+        start_yaw_deg: [2] range of the initial yaw relative to the direction to the
+            target (or to the first waypoint), deg.
+        start_speed: [2] range of the initial speed along the heading, m/s.
+        n_starts: number of start configurations to draw.
+        seed: seed of the start draw.
+        waypoints: [W, 2] points to follow in order before the target, or None.
+    """
+
+    target: np.ndarray
+    start_region: np.ndarray
+    start_yaw_deg: np.ndarray
+    start_speed: np.ndarray
+    n_starts: int
+    seed: int
+    waypoints: np.ndarray | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "target", _frozen_array(self.target, (2,)))
+        object.__setattr__(self, "start_region", _frozen_array(self.start_region, (2, 2)))
+        object.__setattr__(self, "start_yaw_deg", _frozen_array(self.start_yaw_deg, (2,)))
+        object.__setattr__(self, "start_speed", _frozen_array(self.start_speed, (2,)))
+        if self.waypoints is not None:
+            object.__setattr__(self, "waypoints", _frozen_array(self.waypoints, (-1, 2)))
+
+
+@dataclass(frozen=True, eq=False)
+class SupportSurface:
+    """A planar face where a foot may rest.
+
+    Attributes:
+        vertices: [N, 3] polygon, world frame, counter-clockwise seen along -normal
+            (i.e. looking at the face from outside, from above).
+        normal: [3] outward unit normal, world frame.
+        box_index: index of the box in `Terrain.boxes` the face belongs to.
+    """
+
+    vertices: np.ndarray
+    normal: np.ndarray
+    box_index: int
+
+    def __post_init__(self):
+        object.__setattr__(self, "vertices", _frozen_array(self.vertices, (-1, 3)))
+        object.__setattr__(self, "normal", _frozen_array(self.normal, (3,)))
+
+
+def face_polygon(box: Box, axis: int, sign: int) -> tuple[np.ndarray, np.ndarray]:
+    """Corners and outward normal of one face of a box.
+
+    Args:
+        box: the box.
+        axis: 0, 1 or 2, the box axis the face is normal to.
+        sign: +1 or -1, which of the two faces.
+
+    Returns:
+        ([4, 3] corners, world frame, counter-clockwise about the normal;
+         [3] outward unit normal, world frame).
+    """
+    rot = box.rotation
+    normal = sign * rot[:, axis]
+    # Tangent axes u, v with u x v = normal: then (+,+), (-,+), (-,-), (+,-) in (u, v)
+    # turns counter-clockwise seen from the tip of the normal.
+    i, j = (axis + 1) % 3, (axis + 2) % 3
+    u, v = rot[:, i], sign * rot[:, j]
+    hu, hv = box.half[i], box.half[j]
+    centre = box.center + normal * box.half[axis]
+    corners = np.array([centre + su * hu * u + sv * hv * v for su, sv in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
+    return corners, normal
+
+
+@dataclass(frozen=True, eq=False)
+class Terrain:
+    """A terrain: a union of boxes over a void (DESIGN §4).
+
+    Attributes:
+        name: terrain name.
+        bounds: [2, 2] [[xmin, ymin], [xmax, ymax]] of the heightfield, world frame, m.
+        void_height: height where no box covers a point, m.
+        resolution: heightfield cell size, m.
+        boxes: the boxes.
+        scenario: the evaluation scenario, or None (training terrains).
+        text: TOML source of the terrain.
+        path: file the terrain was read from, or None.
+    """
+
+    name: str
+    bounds: np.ndarray
+    void_height: float
+    resolution: float
+    boxes: tuple[Box, ...]
+    scenario: Scenario | None = None
+    text: str = ""
+    path: str | None = None
+    _cache: dict = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "bounds", _frozen_array(self.bounds, (2, 2)))
+        object.__setattr__(self, "boxes", tuple(self.boxes))
+        object.__setattr__(self, "void_height", float(self.void_height))
+        object.__setattr__(self, "resolution", float(self.resolution))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(nx, ny) raster points: (round((xmax - xmin)/res) + 1, round((ymax - ymin)/res) + 1)."""
+        return raster_shape(self.bounds, self.resolution)
+
+    @property
+    def origin(self) -> np.ndarray:
+        """[2] (xmin, ymin), world position of raster point [0, 0], m."""
+        return self.bounds[0].copy()
+
+    def grid_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Raster coordinates: ([nx] x = xmin + i*res, [ny] y = ymin + j*res), world, m."""
+        nx, ny = self.shape
+        return (self.bounds[0, 0] + np.arange(nx) * self.resolution,
+                self.bounds[0, 1] + np.arange(ny) * self.resolution)
+
+    def raster(self) -> np.ndarray:
+        """Heightfield of the terrain (cached, read-only).
+
+        Returns:
+            [nx, ny] float32: heights[i, j] is the highest point of the union of boxes
+            on the vertical line through (xmin + i*res, ymin + j*res), void_height
+            where no box meets that line.
+        """
+        if "raster" not in self._cache:
+            heights = rasterize(self.boxes, self.bounds, self.resolution, self.void_height)
+            heights.setflags(write=False)
+            self._cache["raster"] = heights
+        return self._cache["raster"]
+
+    def height_at(self, xy) -> np.ndarray:
+        """Exact terrain heights by vertical ray cast on the boxes.
+
+        Args:
+            xy: [N, 2] (or [2]) world positions, m.
+
+        Returns:
+            [N] (or scalar) float64 heights, void_height where no box is hit.
+        """
+        points = np.asarray(xy, dtype=np.float64)
+        flat = points.reshape(-1, 2)
+        top = np.full(len(flat), -np.inf)
+        for box in self.boxes:
+            lo, hi = box.aabb()[:, :2]
+            inside = np.all((flat >= lo - _EDGE_TOL) & (flat <= hi + _EDGE_TOL), axis=1)
+            if np.any(inside):
+                sel = flat[inside]
+                top[inside] = np.maximum(top[inside], box.column_top(sel[:, 0], sel[:, 1]))
+        heights = np.where(np.isfinite(top), top, self.void_height)
+        return heights.reshape(points.shape[:-1])
+
+    def support_surfaces(self, mu: float = 0.5) -> list[SupportSurface]:
+        """Box faces a foot may rest on: outward normal within the friction cone.
+
+        A face qualifies when the angle between its outward normal and +z is at most
+        atan(mu). Faces whose centre is covered by another box (a point 1 mm above the
+        centre lies inside it) are left out; partly covered faces are returned whole.
+
+        Args:
+            mu: friction coefficient (> 0).
+
+        Returns:
+            list of SupportSurface, in box order.
+        """
+        if not mu > 0.0:
+            raise TerrainError(f"support_surfaces: mu = {mu!r}: must be > 0")
+        min_nz = math.cos(math.atan(mu))
+        surfaces = []
+        for index, box in enumerate(self.boxes):
+            for axis in range(3):
+                for sign in (1, -1):
+                    corners, normal = face_polygon(box, axis, sign)
+                    if normal[2] < min_nz - 1e-12:
+                        continue
+                    probe = (corners.mean(axis=0) + _BURIED_PROBE * normal)[None]
+                    if any(other.contains(probe)[0] for k, other in enumerate(self.boxes) if k != index):
+                        continue
+                    surfaces.append(SupportSurface(corners, normal, index))
+        return surfaces
+
+    def to_mjcf(self) -> str:
+        """MuJoCo scene of the terrain: one `<geom type="box">` per box in the world body.
+
+        Returns:
+            MJCF XML text; geoms are named box0, box1, ... in box order, `size` is the half
+            extents and `quat` the orientation in MuJoCo's (w, x, y, z) order.
+        """
+        from leas_jax.terrain.export import terrain_to_mjcf
+
+        return terrain_to_mjcf(self)
+
+    def to_mesh(self):
+        """trimesh.Trimesh of all boxes (12 triangles each), world frame."""
+        from leas_jax.terrain.export import terrain_to_mesh
+
+        return terrain_to_mesh(self)
+
+    def export(self, path) -> None:
+        """Write the terrain by file extension: .xml (MJCF), .glb, .obj, .stl (mesh)."""
+        from leas_jax.terrain.export import export_terrain
+
+        export_terrain(self, path)
+
+
+def raster_shape(bounds, resolution: float) -> tuple[int, int]:
+    """(nx, ny) raster points of bounds [2, 2] at `resolution` m: round(extent/res) + 1 per axis."""
+    extent = np.asarray(bounds, dtype=np.float64)[1] - np.asarray(bounds, dtype=np.float64)[0]
+    return int(round(extent[0] / resolution)) + 1, int(round(extent[1] / resolution)) + 1
+
+
+def rasterize(boxes, bounds, resolution: float, void_height: float) -> np.ndarray:
+    """Highest box point above every raster point.
+
+    Each box only touches the raster window of its axis-aligned bounding box, which is
+    evaluated in chunks of at most _CHUNK_POINTS points.
+
+    Args:
+        boxes: sequence of Box.
+        bounds: [2, 2] [[xmin, ymin], [xmax, ymax]], world, m.
+        resolution: cell size, m.
+        void_height: height where no box is met, m.
+
+    Returns:
+        [nx, ny] float32 heights at (xmin + i*res, ymin + j*res).
+    """
+    bounds = np.asarray(bounds, dtype=np.float64)
+    nx, ny = raster_shape(bounds, resolution)
+    top = np.full((nx, ny), -np.inf)
+    for box in boxes:
+        lo, hi = box.aabb()[:, :2]
+        # Window of raster indices whose points may lie in the box footprint.
+        i0, j0 = np.maximum(np.floor((lo - bounds[0]) / resolution - 1e-6).astype(int), 0)
+        i1, j1 = np.minimum(np.ceil((hi - bounds[0]) / resolution + 1e-6).astype(int), [nx - 1, ny - 1])
+        if i0 > i1 or j0 > j1:
+            continue
+        ys = bounds[0, 1] + np.arange(j0, j1 + 1) * resolution
+        rows = max(1, _CHUNK_POINTS // len(ys))
+        for a in range(i0, i1 + 1, rows):
+            b = min(a + rows, i1 + 1)
+            xs = bounds[0, 0] + np.arange(a, b) * resolution
+            column = box.column_top(xs[:, None], ys[None, :])
+            np.maximum(top[a:b, j0:j1 + 1], column, out=top[a:b, j0:j1 + 1])
+    return np.where(np.isfinite(top), top, void_height).astype(np.float32)
+
+
+def replace(terrain: Terrain, **changes) -> Terrain:
+    """Copy of a terrain with some fields changed (the raster cache is not carried over)."""
+    return dataclasses.replace(terrain, **changes)

@@ -358,17 +358,22 @@ class Terrain:
         if not mu > 0.0:
             raise TerrainError(f"support_surfaces: mu = {mu!r}: must be > 0")
         min_nz = math.cos(math.atan(mu))
-        surfaces = []
+        faces = []  # (box index, corners [4, 3], normal [3])
         for index, box in enumerate(self.boxes):
             for axis in range(3):
                 for sign in (1, -1):
                     corners, normal = face_polygon(box, axis, sign)
-                    if normal[2] < min_nz - 1e-12:
-                        continue
-                    probe = (corners.mean(axis=0) + _BURIED_PROBE * normal)[None]
-                    if any(other.contains(probe)[0] for k, other in enumerate(self.boxes) if k != index):
-                        continue
-                    surfaces.append(SupportSurface(corners, normal, index))
+                    if normal[2] >= min_nz - 1e-12:
+                        faces.append((index, corners, normal))
+        if not faces:
+            return []
+        owner = np.array([f[0] for f in faces])
+        probes = np.array([f[1].mean(axis=0) + _BURIED_PROBE * f[2] for f in faces])  # [F, 3]
+        buried = np.zeros(len(faces), dtype=bool)
+        for index, box in enumerate(self.boxes):
+            buried |= box.contains(probes) & (owner != index)
+        surfaces = [SupportSurface(corners, normal, index)
+                    for (index, corners, normal), hidden in zip(faces, buried) if not hidden]
         return surfaces
 
     def to_mjcf(self) -> str:

@@ -1,0 +1,164 @@
+"""`leas terrain ...` sub-commands: generate, show, export.
+
+`leas_jax.cli` calls `register(subparsers)`; each sub-command parser carries
+`func(args)`. Bad input raises UsageError or TerrainError (one line); the CLI prints it.
+Host code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from leas_jax.errors import UsageError
+from leas_jax.terrain.export import EXPORT_EXTENSIONS
+from leas_jax.terrain.loader import load_terrain
+from leas_jax.terrain.model import Terrain
+
+
+def register(subparsers) -> None:
+    """Add `terrain` with sub-commands generate, show and export to an argparse sub-parser set."""
+    parser = subparsers.add_parser("terrain", help="generate, show and export terrain files",
+                                   description="Generate, show and export terrain files (TOML, format v1).")
+    commands = parser.add_subparsers(dest="terrain_command", metavar="COMMAND", required=True)
+
+    gen = commands.add_parser("generate", help="write the seeded training arena or the evaluation terrains",
+                              description="Write the training arena of a seed (to --out or stdout), "
+                                          "or the evaluation terrains into --eval-dir.")
+    gen.add_argument("--seed", type=int, default=0, help="arena seed (default 0)")
+    gen.add_argument("--out", metavar="FILE", help="output TOML file (default: stdout)")
+    gen.add_argument("--eval-dir", metavar="DIR", help="write eval_*.toml into DIR instead of the arena")
+    gen.set_defaults(func=cmd_generate)
+
+    show = commands.add_parser("show", help="draw a terrain's heightmap as a PNG",
+                               description="Top-down heightmap with colour bar and the scenario "
+                                           "(start region, target, waypoints).")
+    show.add_argument("file", metavar="FILE", help="terrain TOML file")
+    show.add_argument("--out", metavar="PNG", required=True, help="output image (.png)")
+    show.set_defaults(func=cmd_show)
+
+    export = commands.add_parser("export", help="export a terrain to MJCF or a mesh",
+                                 description="Export by extension: .xml (MuJoCo MJCF), .glb, .obj, .stl.")
+    export.add_argument("file", metavar="FILE", help="terrain TOML file")
+    export.add_argument("--out", metavar="PATH", required=True, help="output file (.xml, .glb, .obj, .stl)")
+    export.set_defaults(func=cmd_export)
+
+
+def cmd_generate(args: argparse.Namespace) -> None:
+    """Write the training arena of `args.seed` to `args.out` (or stdout), or the evaluation
+    terrains to `args.eval_dir`."""
+    from leas_jax.terrain.generate import generate_eval_terrains, generate_training_arena
+
+    if args.eval_dir is not None:
+        if args.out is not None:
+            raise UsageError("terrain generate: give either --out or --eval-dir, not both")
+        directory = Path(args.eval_dir)
+        if not directory.is_dir():
+            raise UsageError(f"terrain generate: --eval-dir {args.eval_dir}: not a directory")
+        for name, text in generate_eval_terrains().items():
+            path = directory / f"{name}.toml"
+            _write(path, text)
+            print(f"wrote {path}")
+        return
+    if args.seed < 0:
+        raise UsageError(f"terrain generate: --seed {args.seed}: must be >= 0")
+    text = generate_training_arena(args.seed)
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        _write(Path(args.out), text)
+        print(f"wrote {args.out}")
+
+
+def cmd_show(args: argparse.Namespace) -> None:
+    """Draw the heightmap of `args.file` into the PNG `args.out`."""
+    out = Path(args.out)
+    if out.suffix.lower() != ".png":
+        raise UsageError(f"terrain show: --out {args.out}: the image must be a .png file")
+    terrain = load_terrain(args.file)
+    figure = draw_terrain(terrain)
+    try:
+        figure.savefig(out, dpi=150)
+    except OSError as err:
+        raise UsageError(f"terrain show: --out {args.out}: cannot write: {err.strerror or err}") from None
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(figure)
+    print(f"wrote {out}")
+
+
+def cmd_export(args: argparse.Namespace) -> None:
+    """Export `args.file` to `args.out` (format by extension)."""
+    out = Path(args.out)
+    if out.suffix.lower() not in EXPORT_EXTENSIONS:
+        raise UsageError(f"terrain export: --out {args.out}: unknown format "
+                         f"{out.suffix or '(no extension)'!r}, use one of {', '.join(EXPORT_EXTENSIONS)}")
+    terrain = load_terrain(args.file)
+    terrain.export(out)
+    print(f"wrote {out}")
+
+
+def draw_terrain(terrain: Terrain):
+    """Top-down heightmap figure of a terrain with its scenario, if any.
+
+    Void points are drawn in a separate dark colour so that holes stand out from low
+    ground. Start region: dashed rectangle; target: star; waypoints: numbered dots
+    joined in order.
+
+    Returns:
+        matplotlib Figure (Agg backend; the caller saves and closes it).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    heights = np.asarray(terrain.raster(), dtype=np.float64)
+    (xmin, ymin), (xmax, ymax) = terrain.bounds
+    half = terrain.resolution / 2
+    extent = (xmin - half, xmax + half, ymin - half, ymax + half)
+    void = heights <= terrain.void_height
+    shown = np.ma.masked_where(void, heights)
+    width = 8.0
+    figure, axes = plt.subplots(figsize=(width, max(3.0, width * (ymax - ymin) / (xmax - xmin))),
+                                layout="constrained")
+    cmap = plt.get_cmap("viridis").copy()
+    cmap.set_bad("#202020")
+    # heights[i, j] is at (x_i, y_j): transpose so that rows are y for imshow.
+    image = axes.imshow(shown.T, origin="lower", extent=extent, cmap=cmap, interpolation="nearest")
+    figure.colorbar(image, ax=axes, label=f"height (m); void (z = {terrain.void_height:g}) in black",
+                    shrink=0.9)
+    scenario = terrain.scenario
+    if scenario is not None:
+        (rx0, ry0), (rx1, ry1) = scenario.start_region
+        axes.add_patch(Rectangle((rx0, ry0), rx1 - rx0, ry1 - ry0, fill=False, edgecolor="red",
+                                 linestyle="--", linewidth=1.5, label="start region"))
+        route = [np.mean(scenario.start_region, axis=0)]
+        if scenario.waypoints is not None:
+            route += list(scenario.waypoints)
+            axes.plot(scenario.waypoints[:, 0], scenario.waypoints[:, 1], "o", color="gold",
+                      markeredgecolor="black", label="waypoints")
+            for k, (wx, wy) in enumerate(scenario.waypoints):
+                axes.annotate(str(k + 1), (wx, wy), textcoords="offset points", xytext=(4, 4), fontsize=8)
+        route.append(scenario.target)
+        route = np.array(route)
+        axes.plot(route[:, 0], route[:, 1], ":", color="black", linewidth=1)
+        axes.plot(*scenario.target, "*", color="red", markersize=14, markeredgecolor="black", label="target")
+        axes.legend(loc="upper right", fontsize=8)
+    axes.set_xlabel("x (m)")
+    axes.set_ylabel("y (m)")
+    axes.set_title(f"{terrain.name}: {len(terrain.boxes)} boxes, resolution {terrain.resolution:g} m")
+    axes.set_aspect("equal")
+    return figure
+
+
+def _write(path: Path, text: str) -> None:
+    try:
+        path.write_text(text, encoding="utf-8")
+    except OSError as err:
+        raise UsageError(f"cannot write {path}: {err.strerror or err}") from None

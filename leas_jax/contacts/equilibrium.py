@@ -1,0 +1,233 @@
+"""Static equilibrium of a stance: hpp-centroidal-dynamics robustness LP and our own LP.
+
+Host-only, not jittable. DESIGN §6 check 4: the stance is in static equilibrium with
+robustness >= 0 by the linear program of hpp-centroidal-dynamics over the sole
+corners (mu = 0.5). `sole_corners` gives those contact points; `HppEquilibrium` wraps
+the library; `static_equilibrium_lp` is an independent formulation with SciPy's
+`linprog` used to cross-check it (tests/test_contacts_equilibrium.py).
+
+The library's Python module does not find its shared libraries by itself (they live
+in the cmeel prefix, which is not on the loader path), so `_import_hpp_centroidal_dynamics`
+loads them with RTLD_GLOBAL before importing it.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import os
+import site
+import sysconfig
+
+import numpy as np
+
+from leas_jax.contacts.model import FRICTION, SOLE_LENGTH, SOLE_WIDTH
+
+GRAVITY = 9.81  # m/s^2, hpp-centroidal-dynamics' value (Equilibrium uses g = -9.81 e_z)
+# Friction-cone generators per contact point: hpp-centroidal-dynamics' usual choice
+# (its tests and the RB-PRM Talos scripts use 4), an inscribed pyramid of the cone.
+GENERATORS_PER_CONTACT = 4
+# Shared libraries of hpp-centroidal-dynamics and its dependencies, in load order.
+_HPP_LIBRARIES = ("libeigenpy.so", "libcdd.so.0", "libCoinUtils.so.3", "libClp.so.1",
+                  "libqpOASES.so.3.2", "libhpp-centroidal-dynamics.so")
+
+
+def _cmeel_lib_dir() -> str:
+    """The `cmeel.prefix/lib` folder holding hpp-centroidal-dynamics' shared libraries.
+
+    Raises:
+        ImportError: no site-packages folder has it.
+    """
+    candidates = [sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]]
+    candidates += site.getsitepackages() if hasattr(site, "getsitepackages") else []
+    candidates.append(site.getusersitepackages())
+    seen = []
+    for base in candidates:
+        path = os.path.join(base, "cmeel.prefix", "lib")
+        seen.append(path)
+        if os.path.isfile(os.path.join(path, "libhpp-centroidal-dynamics.so")):
+            return path
+    raise ImportError("hpp-centroidal-dynamics shared library not found; looked for "
+                      "libhpp-centroidal-dynamics.so in: " + ", ".join(dict.fromkeys(seen))
+                      + " (install the pinned `hpp-centroidal-dynamics` wheel: make venv)")
+
+
+@functools.lru_cache(maxsize=1)
+def _import_hpp_centroidal_dynamics():
+    """Import `hpp_centroidal_dynamics` after loading its shared libraries globally."""
+    import eigenpy  # noqa: F401  (registers the Eigen <-> NumPy converters first)
+
+    lib_dir = _cmeel_lib_dir()
+    for name in _HPP_LIBRARIES:
+        path = os.path.join(lib_dir, name)
+        if not os.path.exists(path):
+            raise ImportError(f"hpp-centroidal-dynamics dependency {name} missing from {lib_dir}")
+        ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+    import hpp_centroidal_dynamics
+
+    return hpp_centroidal_dynamics
+
+
+def sole_corners(feet: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Contact points and normals of the feet in contact: the sole rectangle's corners.
+
+    Args:
+        feet: [F, 7] sole placements (xyz + quaternion xyzw), world frame; rows with
+            NaN (feet in the air) are skipped.
+
+    Returns:
+        (points [4 C, 3], normals [4 C, 3]) world frame, for the C feet in contact;
+        the normal of each corner is its sole's z axis.
+    """
+    from leas_jax.contacts.model import matrix_from_quat_xyzw
+
+    feet = np.asarray(feet, dtype=np.float64).reshape(-1, 7)
+    feet = feet[~np.any(np.isnan(feet), axis=1)]
+    if len(feet) == 0:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    rot = matrix_from_quat_xyzw(feet[:, 3:])
+    half = np.array([[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0]
+                     for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
+    points = feet[:, None, :3] + np.einsum("fij,cj->fci", rot, half)
+    normals = np.broadcast_to(rot[:, None, :, 2], points.shape)
+    return points.reshape(-1, 3), np.ascontiguousarray(normals.reshape(-1, 3))
+
+
+class HppEquilibrium:
+    """Robustness of static equilibrium with hpp-centroidal-dynamics (LP algorithm).
+
+    Host-only, not jittable; holds a solver object, one per process/thread.
+
+    The LP (hpp-centroidal-dynamics `EQUILIBRIUM_ALGORITHM_LP`) finds generator
+    coefficients b of the linearised friction cones with G b = D c + d (Newton-Euler
+    of a static body of mass m at CoM c) maximising b0 <= min(b); the robustness is
+    b0 >= 0 when the CoM is in equilibrium, negative when not.
+    """
+
+    def __init__(self, mass: float, mu: float = FRICTION, use_clp: bool = False):
+        hpp = _import_hpp_centroidal_dynamics()
+        self._hpp = hpp
+        solver = hpp.SolverLP.SOLVER_LP_CLP if use_clp else hpp.SolverLP.SOLVER_LP_QPOASES
+        self.mass = float(mass)
+        self.mu = float(mu)
+        self._eq = hpp.Equilibrium("talos", self.mass, GENERATORS_PER_CONTACT, solver)
+        self._contacts_key = None
+
+    def set_contacts(self, points: np.ndarray, normals: np.ndarray) -> None:
+        """Set contact points [N, 3] and unit normals [N, 3], world frame."""
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        normals = np.ascontiguousarray(normals, dtype=np.float64)
+        key = (points.tobytes(), normals.tobytes())
+        if key == self._contacts_key:
+            return
+        if not self._eq.setNewContacts(points, normals, self.mu,
+                                       self._hpp.EquilibriumAlgorithm.EQUILIBRIUM_ALGORITHM_LP):
+            raise RuntimeError("hpp-centroidal-dynamics rejected the contact set")
+        self._contacts_key = key
+
+    def robustness(self, com: np.ndarray) -> float:
+        """Robustness of the current contact set for a CoM [3] (world); -inf if the LP fails."""
+        status, value = self._eq.computeEquilibriumRobustness(np.asarray(com, dtype=np.float64))
+        if status != self._hpp.LP_status.LP_STATUS_OPTIMAL:
+            return -np.inf
+        return float(value)
+
+    def feet_robustness(self, feet: np.ndarray, com: np.ndarray) -> float:
+        """Robustness of a stance: feet [F, 7] (NaN rows in the air), CoM [3], world."""
+        points, normals = sole_corners(feet)
+        if len(points) == 0:
+            return -np.inf
+        self.set_contacts(points, normals)
+        return self.robustness(com)
+
+
+def friction_generators(normals: np.ndarray, mu: float = FRICTION,
+                        count: int = GENERATORS_PER_CONTACT) -> np.ndarray:
+    """Edges of the friction pyramids inscribed in the cones at each contact.
+
+    Same pyramid as hpp-centroidal-dynamics (`Equilibrium::computeGenerators`), so
+    that robustness values can be compared: tangents t1 = n x e_y (n x e_x when n is
+    along e_y), t2 = n x t1, edges n + mu (sin a t1 + cos a t2), a = pi/4 + 2 pi k / count.
+
+    Args:
+        normals: [N, 3] unit contact normals.
+        mu: friction coefficient.
+        count: edges per cone.
+
+    Returns:
+        [N, count, 3] unit edge directions.
+    """
+    normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    t1 = np.cross(normals, np.array([0.0, 1.0, 0.0]))
+    along_y = np.linalg.norm(t1, axis=1) < 1e-5
+    t1[along_y] = np.cross(normals[along_y], np.array([1.0, 0.0, 0.0]))
+    t2 = np.cross(normals, t1)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 /= np.linalg.norm(t2, axis=1, keepdims=True)
+    angles = np.pi / 4 + 2.0 * np.pi * np.arange(count) / count
+    edges = (normals[:, None, :] + mu * (np.sin(angles)[None, :, None] * t1[:, None, :]
+                                         + np.cos(angles)[None, :, None] * t2[:, None, :]))
+    return edges / np.linalg.norm(edges, axis=2, keepdims=True)
+
+
+def robustness_scale(mu: float = FRICTION, count: int = GENERATORS_PER_CONTACT) -> float:
+    """Factor from the LP's b0 to hpp-centroidal-dynamics' robustness e_max.
+
+    hpp-centroidal-dynamics reports e_max = b0 |f0 x g0| with f0 the sum of one
+    cone's unit edges and g0 one edge (the distance from f0 to the cone boundary
+    when b0 = 1); it depends only on mu and the edge count.
+    """
+    edges = friction_generators(np.array([[0.0, 0.0, 1.0]]), mu, count)[0]
+    return float(np.linalg.norm(np.cross(edges.sum(axis=0), edges[0])))
+
+
+def static_equilibrium_lp(points: np.ndarray, normals: np.ndarray, com: np.ndarray, mass: float,
+                          mu: float = FRICTION, count: int = GENERATORS_PER_CONTACT) -> float:
+    """Independent robustness LP with SciPy (slow; for cross-checks and tests).
+
+    Static equilibrium of a body of mass m at CoM c under gravity g = -9.81 e_z with
+    contact forces f_i = sum_k b_ik e_ik (e_ik the pyramid edges, b_ik >= 0):
+
+        (1) sum_i f_i            = -m g            (force balance)
+        (2) sum_i p_i x f_i      = -c x m g        (moment balance about the origin)
+
+    and b0* = max b0 subject to (1), (2), b_ik >= b0 (b0 free); with b_ik = b0 + s_ik,
+    s_ik >= 0 this is a standard-form LP. The robustness is b0* times
+    `robustness_scale`: the definition of hpp-centroidal-dynamics' LP algorithm, so
+    the values match up to solver tolerance; the sign (equilibrium or not) is what
+    DESIGN §6 check 4 uses.
+
+    Args:
+        points: [N, 3] contact points, world frame.
+        normals: [N, 3] unit normals.
+        com: [3] centre of mass, world frame.
+        mass: kg.
+        mu: friction coefficient.
+        count: edges per cone.
+
+    Returns:
+        Robustness b0 (>= 0 iff static equilibrium with the pyramid cones); -inf if
+        the LP is infeasible, +inf if unbounded.
+    """
+    from scipy.optimize import linprog
+
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    edges = friction_generators(normals, mu, count).reshape(-1, 3)  # [M, 3]
+    lever = np.repeat(points, count, axis=0)
+    wrench = np.vstack([edges.T, np.cross(lever, edges).T])  # [6, M]
+    weight = np.array([0.0, 0.0, mass * GRAVITY])
+    target = np.concatenate([weight, np.cross(np.asarray(com, dtype=np.float64), weight)])
+    # Variables x = (s [M], b0): wrench (s + b0) = target; maximise b0.
+    m = wrench.shape[1]
+    a_eq = np.hstack([wrench, wrench.sum(axis=1, keepdims=True)])
+    cost = np.zeros(m + 1)
+    cost[-1] = -1.0
+    bounds = [(0.0, None)] * m + [(None, None)]
+    result = linprog(cost, A_eq=a_eq, b_eq=target, bounds=bounds, method="highs")
+    if result.status == 2:
+        return -np.inf
+    if result.status == 3:
+        return np.inf
+    if result.status != 0:
+        raise RuntimeError(f"linprog failed: {result.message}")
+    return float(result.x[-1]) * robustness_scale(mu, count)

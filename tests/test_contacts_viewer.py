@@ -1,0 +1,253 @@
+"""Plan viewers: HTML structure and data, the inline renderer run under Node with a
+recording WebGL stub, footprint geometry, mesh decimation and the footsteps PNG."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+import shutil
+import subprocess
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from leas_jax.contacts import viewer
+
+# Ground x in [-1, 1.5], a hole for x in [1.5, 2], a step x in [2, 3] 0.1 m high.
+TERRAIN = """
+name = "viewer_test"
+bounds = [[-1.0, -1.0], [3.0, 1.0]]
+void_height = -2.0
+resolution = 0.02
+
+[[box]]
+center = [0.25, 0.0, -0.1]
+size = [2.5, 2.0, 0.2]
+
+[[box]]
+center = [2.5, 0.0, 0.0]
+size = [1.0, 2.0, 0.2]
+"""
+
+
+@dataclass(frozen=True)
+class FakePlan:
+    """The DESIGN §6 plan attributes the viewers read."""
+
+    q: np.ndarray
+    feet: np.ndarray
+    guide_index: np.ndarray
+    last_valid_index: int
+    coverage: float
+    terrain: str
+    guide: np.ndarray
+
+
+@pytest.fixture(scope="module")
+def plan() -> FakePlan:
+    """Seven postures of Talos at half-sitting: left step, right step, left step.
+
+    Sole rows come from Pinocchio forward kinematics of half-sitting (soles at
+    z = 0, the ground top), shifted along x; the stance foot keeps its row, the
+    root sits between the feet.
+    """
+    import example_robot_data
+    import pinocchio as pin
+
+    robot = example_robot_data.load("talos")
+    model, data = robot.model, robot.model.createData()
+    frames = [model.getFrameId(name) for name in ("leg_left_sole_fix_joint", "leg_right_sole_fix_joint")]
+    base = model.referenceConfigurations["half_sitting"].copy()
+    pin.framesForwardKinematics(model, data, base)
+    soles = np.array([np.concatenate([data.oMf[f].translation, pin.Quaternion(data.oMf[f].rotation).coeffs()])
+                      for f in frames])
+    foot_x = [0.0, 0.0]
+    qs, feet = [], []
+    for air, lands in ((None, None), (0, None), (None, 0), (1, None), (None, 1), (0, None), (None, 0)):
+        if lands is not None:
+            foot_x[lands] += 0.2
+        rows = soles.copy()
+        rows[:, 0] += foot_x
+        if air is not None:
+            rows[air] = np.nan
+        q = base.copy()
+        q[0] = float(np.mean(foot_x))
+        qs.append(q)
+        feet.append(rows)
+    guide = np.stack([np.linspace(0.0, 2.4, 25), np.zeros(25), np.full(25, 1.02), np.zeros(25)], axis=1)
+    return FakePlan(q=np.array(qs), feet=np.array(feet), guide_index=np.arange(7) * 2, last_valid_index=12,
+                    coverage=0.5, terrain=TERRAIN, guide=guide)
+
+
+def _decode(b64: str, dtype) -> np.ndarray:
+    return np.frombuffer(base64.b64decode(b64), dtype=dtype)
+
+
+def _page_parts(text: str) -> tuple[dict, str]:
+    data = re.search(r'<script id="plan-data" type="application/json">(.*?)</script>', text, re.S).group(1)
+    code = re.search(r"<script>\n(.*?)</script>", text, re.S).group(1)
+    return json.loads(data.replace("<\\/", "</")), code
+
+
+def test_footprints_merge_held_placements_and_have_sole_size(plan):
+    prints = viewer.footprints(plan)
+    # Postures: both, L air, both (L moved), R air, both (R moved), L air, both (L moved):
+    # initial L and R, then L at k=2, R at k=4, L at k=6.
+    assert [(foot, k) for foot, k, _ in prints] == [(0, 0), (1, 0), (0, 2), (1, 4), (0, 6)]
+    assert viewer.count_footsteps(plan) == 3
+    corners = prints[0][2]
+    assert np.linalg.norm(corners[0] - corners[1]) == pytest.approx(0.20)
+    assert np.linalg.norm(corners[1] - corners[2]) == pytest.approx(0.13)
+    assert np.allclose(corners.mean(axis=0), plan.feet[0, 0, :3])
+
+
+def test_quaternion_matches_pinocchio():
+    import pinocchio as pin
+
+    rng = np.random.default_rng(0)
+    quats = rng.normal(size=(20, 4))
+    quats /= np.linalg.norm(quats, axis=1, keepdims=True)
+    expected = [pin.Quaternion(q[3], q[0], q[1], q[2]).toRotationMatrix() for q in quats]
+    assert np.allclose(viewer.quaternion_xyzw_to_matrix(quats), expected, atol=1e-12)
+
+
+def test_decimate_collapses_small_triangles():
+    # Vertices 0 and 1 are 1 mm apart: one 1 cm cell, merged at their mean
+    # (0.0005, 0, 0). Face [0, 1, 2] collapses; [0, 2, 3] survives; [1, 2, 3]
+    # becomes a duplicate of it and is dropped.
+    vertices = np.array([[0.0, 0, 0], [0.001, 0, 0], [1.0, 0, 0], [0, 1.0, 0]])
+    faces = np.array([[0, 1, 2], [0, 2, 3], [1, 2, 3]])
+    new_vertices, new_faces = viewer.decimate(vertices, faces, 0.01)
+    assert new_faces.shape == (1, 3)
+    assert np.allclose(new_vertices[new_faces[0]], [[0.0005, 0, 0], [1.0, 0, 0], [0, 1.0, 0]])
+
+
+def test_write_html_is_self_contained_with_consistent_data(plan, tmp_path):
+    path = tmp_path / "view.html"
+    viewer.write_html(plan, path, max_postures=4)
+    text = path.read_text()
+    assert text.startswith("<!DOCTYPE html>") and text.rstrip().endswith("</html>")
+    assert path.stat().st_size < 3e6
+    assert re.search(r"<script[^>]+src=|<link|https?://|@import", text) is None  # nothing fetched
+    data, code = _page_parts(text)
+    assert "webgl2" in code and "mousemove" in code and "wheel" in code
+    # Terrain: 2 boxes, 8 vertices and 12 triangles each.
+    assert _decode(data["terrain"]["positions"], "<f4").size == 2 * 8 * 3
+    assert _decode(data["terrain"]["indices"], "<u4").size == 2 * 12 * 3
+    assert np.allclose(_decode(data["guide"], "<f4").reshape(-1, 3), plan.guide[:, :3], atol=1e-6)
+    assert _decode(data["footprints"]["left"], "<f4").size == 3 * 4 * 3
+    assert _decode(data["footprints"]["right"], "<f4").size == 2 * 4 * 3
+    # Robot: 4 postures spread over 7, first and last kept.
+    robot = data["robot"]
+    assert robot["postures"] == [0, 2, 4, 6] and robot["guide_index"] == [0, 4, 8, 12]
+    n_geoms = len(robot["geoms"])
+    matrices = _decode(robot["matrices"], "<f4").reshape(4, n_geoms, 3, 4)
+    for mesh in data["meshes"]:
+        vertices = _decode(mesh["positions"], "<f4").reshape(-1, 3)
+        indices = _decode(mesh["indices"], "<u2" if mesh["index_type"] == "u16" else "<u4")
+        assert indices.size % 3 == 0 and indices.max() < len(vertices)
+    assert all(0 <= g["mesh"] < len(data["meshes"]) for g in robot["geoms"])
+    # The left ankle-roll mesh sits above the left sole (sole frame 0.107 m below
+    # the ankle): its placement at posture 2 (plan index 4) is ~0.1 m above feet[4, 0].
+    model, visual_model, *_ = viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)
+    drawn = [g for g, geom in enumerate(visual_model.geometryObjects)
+             if viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)[3][g] >= 0]
+    slot = drawn.index(visual_model.getGeometryId("leg_left_6_link_0"))
+    ankle = matrices[2, slot, :, 3]
+    assert np.linalg.norm(ankle[:2] - plan.feet[4, 0, :2]) < 0.05
+    assert 0.08 < ankle[2] - plan.feet[4, 0, 2] < 0.13
+
+
+def test_write_html_without_robot_is_small(plan, tmp_path):
+    path = tmp_path / "view.html"
+    viewer.write_html(plan, path, robot=False)
+    data, _ = _page_parts(path.read_text())
+    assert data["robot"] is None and data["meshes"] == []
+    assert path.stat().st_size < 50_000
+
+
+# Minimal DOM + WebGL2 stand-ins: every gl call is recorded, constants are their
+# names. Enough to execute the page's script end to end and count draw calls.
+_HARNESS = r"""
+const calls = [];
+const glStub = new Proxy({}, {get(target, name) {
+  if (typeof name !== "string") return undefined;
+  if (/^[A-Z0-9_]+$/.test(name)) return name;
+  return (...args) => {
+    calls.push([name, args.map(a => (typeof a === "string" || typeof a === "number") ? a : null)]);
+    if (name === "getShaderParameter" || name === "getProgramParameter") return true;
+    if (name === "getAttribLocation") return 0;
+    return {};
+  };
+}});
+const elements = {};
+function element(id) {
+  if (!elements[id]) elements[id] = {id, style: {}, dataset: {}, value: "0", max: "0", checked: id === "show-robot",
+    textContent: "", innerHTML: "", clientWidth: 800, clientHeight: 600, width: 0, height: 0,
+    addEventListener() {}, getContext: kind => (kind === "webgl2" ? glStub : null)};
+  return elements[id];
+}
+element("plan-data").textContent = PLAN_JSON;
+global.document = {getElementById: element, body: element("body")};
+global.window = {addEventListener() {}, devicePixelRatio: 1};
+global.atob = s => Buffer.from(s, "base64").toString("binary");
+function drawsOf(from) {
+  const out = {};
+  for (const [name, args] of calls.slice(from)) if (name.startsWith("draw")) {
+    const key = name + ":" + args[0]; out[key] = (out[key] || 0) + 1; }
+  return out;
+}
+"""
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="Node.js not installed")
+def test_html_renderer_runs_under_node(plan, tmp_path):
+    path = tmp_path / "view.html"
+    viewer.write_html(plan, path, max_postures=4)
+    data, code = _page_parts(path.read_text())
+    n_geoms = len(data["robot"]["geoms"])
+    script = (f"const PLAN_JSON = {json.dumps(json.dumps(data))};\n" + _HARNESS + code + r"""
+const first = drawsOf(0);
+const mark = calls.length;
+element("show-all").checked = true;
+element("posture").value = "3";
+element("show-all").onchange();
+const all = drawsOf(mark);
+console.log(JSON.stringify({first, all, rendered: element("body").dataset.rendered,
+                            label: element("posture-label").textContent, max: element("posture").max}));
+""")
+    (tmp_path / "run.js").write_text(script)
+    done = subprocess.run(["node", str(tmp_path / "run.js")], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    # First frame: terrain + the robot at one posture (indexed), guide lines,
+    # footprint fills and outlines (arrays).
+    assert out["first"]["drawElements:TRIANGLES"] == 1 + n_geoms
+    assert out["first"]["drawArrays:LINE_STRIP"] == 2  # covered part and failed tail
+    assert out["first"]["drawArrays:TRIANGLES"] == 2 and out["first"]["drawArrays:LINES"] == 2
+    # "All stored postures": 4 robots.
+    assert out["all"]["drawElements:TRIANGLES"] == 1 + 4 * n_geoms
+    assert out["rendered"] == "2" and out["max"] == 3
+    assert out["label"] == "#0 (guide index 0)"
+
+
+def test_footsteps_png_shows_feet_guide_and_failed_tail(plan, tmp_path):
+    import matplotlib.image
+
+    path = tmp_path / "steps.png"
+    viewer.write_footsteps_png(plan, path)
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rgb = matplotlib.image.imread(str(path))[..., :3]
+
+    def has(color, tol=0.08):
+        return bool((np.abs(rgb - np.asarray(color)).max(axis=-1) < tol).any())
+
+    assert has((1.0, 0.0, 0.0))  # failed guide tail (red)
+    assert has((0.196, 0.804, 0.196))  # covered guide (limegreen)
+    assert has((0.043, 0.102, 0.2))  # the hole (#0b1a33)
+    # Footprint fills: foot colour at alpha 0.55 over the light-grey ground.
+    ground = rgb[rgb.shape[0] // 2, rgb.shape[1] // 4]
+    for color in viewer.FOOT_COLORS:
+        assert has(0.55 * np.asarray(color) + 0.45 * ground, tol=0.06)

@@ -172,9 +172,14 @@ class PathRunner:
     Built once per worker from a `WorkerSpec`: loads the terrain and the planner
     (the Talos model and its sample database are built here, not per path).
     A remote backend (see `register_backend`) instantiates it on its workers.
+
+    Args:
+        spec: terrain text, config and planner.
+        warm_up: build the generator's cached model now (workers) rather than
+            on the first path (in-process use).
     """
 
-    def __init__(self, spec: WorkerSpec):
+    def __init__(self, spec: WorkerSpec, warm_up: bool = True):
         from leas_jax.terrain import loads_terrain
 
         self.terrain = loads_terrain(spec.terrain_text, source=spec.terrain_source)
@@ -185,7 +190,8 @@ class PathRunner:
 
             self.config = spec.config if spec.config is not None else GeneratorConfig()
             self.plan_fn = plan_contacts
-            self._warm_up()
+            if warm_up:
+                self._warm_up()
         else:
             self.config = spec.config
             self.plan_fn = spec.plan_fn
@@ -302,7 +308,8 @@ class _InlineBackend:
     workers = 0
 
     def __init__(self, spec: WorkerSpec):
-        self._runner = PathRunner(spec)
+        # No warm-up: in the caller's process the model loads on the first path anyway.
+        self._runner = PathRunner(spec, warm_up=False)
         self._closed = False
 
     def submit(self, guides, timestep, seeds):

@@ -251,3 +251,15 @@ def test_footsteps_png_shows_feet_guide_and_failed_tail(plan, tmp_path):
     ground = rgb[rgb.shape[0] // 2, rgb.shape[1] // 4]
     for color in viewer.FOOT_COLORS:
         assert has(0.55 * np.asarray(color) + 0.45 * ground, tol=0.06)
+
+
+def test_empty_plan_still_renders(plan, tmp_path):
+    # A generator that fails at the first pose returns no posture at all.
+    empty = FakePlan(q=np.zeros((0, 39)), feet=np.zeros((0, 2, 7)), guide_index=np.zeros(0, int),
+                     last_valid_index=-1, coverage=0.0, terrain=TERRAIN, guide=plan.guide)
+    assert viewer.footprints(empty) == [] and viewer.count_footsteps(empty) == 0
+    viewer.write_html(empty, tmp_path / "v.html")
+    data, _ = _page_parts((tmp_path / "v.html").read_text())
+    assert data["robot"] is None and data["last_valid_index"] == -1
+    viewer.write_footsteps_png(empty, tmp_path / "v.png")
+    assert (tmp_path / "v.png").stat().st_size > 1000

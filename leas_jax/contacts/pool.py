@@ -385,7 +385,9 @@ class _ProcessBackend:
         self._task_timeout = task_timeout
         self._max_attempts = max_attempts
         self._max_tasks = max_tasks_per_worker
-        self._lock = threading.Lock()
+        # Re-entrant: a done-callback of a future runs in the dispatcher thread
+        # with the lock held and may call submit().
+        self._lock = threading.RLock()
         self._queue: collections.deque[_Task] = collections.deque()
         self._keys = itertools.count()
         self._live_jobs: dict[int, _Job] = {}

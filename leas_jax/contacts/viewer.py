@@ -101,7 +101,10 @@ def footprints(plan) -> list[tuple[int, int, np.ndarray]]:
 
 def count_footsteps(plan) -> int:
     """Number of steps: placements of a foot after the initial stance (liftoff then landing)."""
-    initial = sum(1 for foot in (0, 1) if np.isfinite(np.asarray(plan.feet)[0, foot]).all())
+    feet = np.asarray(plan.feet)
+    if feet.shape[0] == 0:
+        return 0
+    initial = sum(1 for foot in (0, 1) if np.isfinite(feet[0, foot]).all())
     return max(0, len(footprints(plan)) - initial)
 
 

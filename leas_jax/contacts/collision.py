@@ -1,0 +1,255 @@
+"""Collision checks of Talos postures against the terrain boxes and between the legs (coal).
+
+Host-only (coal, NumPy), not jittable. Geometry placements come either from
+Pinocchio (`placements_pinocchio`, used by the verifier) or from a NumPy forward
+kinematics of the legs with the upper body rigid at half-sitting
+(`placements_fast`, used by the generator; tests check that both agree). Each
+geometry's local bounding box is moved to the world frame and tested against the
+terrain boxes' bounding boxes first, so that coal only sees pairs that may touch.
+
+Terrain collision objects (`coal.Box` + transform per terrain box) are built once per
+terrain object and cached (`terrain_collision`).
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from leas_jax.contacts.model import LEFT, RIGHT, TalosModel
+
+# Leg links whose meshes are checked for leg-leg and leg-body self-collision: thigh,
+# shin, ankle pitch and foot (links 1-2 sit inside the pelvis and always touch it).
+SELF_COLLISION_LINKS = (3, 4, 5, 6)
+
+
+@dataclass
+class TerrainCollision:
+    """coal objects of a terrain's boxes.
+
+    Attributes:
+        shapes: coal.Box per terrain box (full extents).
+        transforms: coal.Transform3s per box (world_R_box, centre).
+        aabb: [B, 2, 3] world axis-aligned bounds (min, max) of each box.
+    """
+
+    shapes: list
+    transforms: list
+    aabb: np.ndarray
+
+
+_TERRAIN_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def terrain_collision(terrain) -> TerrainCollision:
+    """The coal objects of `terrain` (a leas_jax.terrain.Terrain), built once per terrain object."""
+    cached = _TERRAIN_CACHE.get(terrain)
+    if cached is None:
+        import coal
+
+        shapes, transforms, aabb = [], [], []
+        for box in terrain.boxes:
+            shapes.append(coal.Box(*(float(s) for s in box.size)))
+            transforms.append(coal.Transform3s(np.array(box.rotation), np.array(box.center, dtype=np.float64)))
+            aabb.append(box.aabb())
+        cached = TerrainCollision(shapes, transforms, np.array(aabb).reshape(-1, 2, 3))
+        _TERRAIN_CACHE[terrain] = cached
+    return cached
+
+
+class RobotCollision:
+    """Robot-side collision data derived from a TalosModel.
+
+    Host-only, not jittable; one per process (`robot_collision(talos)` caches it).
+
+    Attributes:
+        geometries: coal geometry per collision object of `talos.geom_model`.
+        names: geometry names.
+        local_center: [G, 3], local_half: [G, 3] bounding box of each geometry in its
+            own frame (coal's local AABB).
+        parent: [G] Pinocchio joint of each geometry.
+        joint_geom: [G, 4, 4] joint-to-geometry placements.
+        self_pairs: [P, 2] geometry index pairs checked for self-collision.
+        rootMg_upper: [G, 4, 4] root-to-geometry placements at half-sitting (valid for
+            the geometries not on the legs).
+        leg_of: [G] 0 / 1 for left / right leg geometries, -1 for the rest.
+        leg_link: [G] link number 1..6 inside the leg, 0 for the rest.
+    """
+
+    def __init__(self, talos: TalosModel):
+        import pinocchio as pin
+
+        gm = talos.geom_model
+        self.geometries = [g.geometry for g in gm.geometryObjects]
+        self.names = [g.name for g in gm.geometryObjects]
+        centers, halves = [], []
+        for geom in self.geometries:
+            geom.computeLocalAABB()
+            lo, hi = np.array(geom.aabb_local.min_), np.array(geom.aabb_local.max_)
+            centers.append(0.5 * (lo + hi))
+            halves.append(0.5 * (hi - lo))
+        self.local_center = np.array(centers)
+        self.local_half = np.array(halves)
+        self.parent = np.array([g.parentJoint for g in gm.geometryObjects])
+        self.joint_geom = np.array([g.placement.homogeneous for g in gm.geometryObjects])
+        self.leg_of = np.full(len(self.names), -1)
+        self.leg_link = np.zeros(len(self.names), dtype=np.int64)
+        for side in (LEFT, RIGHT):
+            for g in talos.leg_geom_ids[side]:
+                self.leg_of[g] = side
+                self.leg_link[g] = int(self.names[g].split("_")[2])
+        # Root-frame placements of all geometries at half-sitting (root at the origin).
+        data = talos.model.createData()
+        gd = pin.GeometryData(gm)
+        pin.updateGeometryPlacements(talos.model, data, gm, gd, talos.q_ref)
+        self.rootMg_upper = np.array([gd.oMg[g].homogeneous for g in range(len(self.names))])
+        self.self_pairs = self._self_pairs(talos)
+        self._joint_ids = [talos.model.getJointId(f"{prefix}_{k}_joint")
+                           for prefix in ("leg_left", "leg_right") for k in range(1, 7)]
+
+    def _self_pairs(self, talos: TalosModel) -> np.ndarray:
+        """Leg links 3-6 vs the other leg's links 3-6, and vs non-leg geometries not disabled in the SRDF."""
+        import pinocchio as pin
+
+        gm = talos.geom_model.copy()
+        gm.addAllCollisionPairs()
+        pin.removeCollisionPairs(talos.model, gm, talos.srdf_path)
+        allowed = {(p.first, p.second) for p in gm.collisionPairs}
+        pairs = []
+        checked = [g for g in range(len(self.names)) if self.leg_link[g] in SELF_COLLISION_LINKS]
+        for a in checked:
+            for b in range(len(self.names)):
+                if (a, b) not in allowed and (b, a) not in allowed:
+                    continue
+                if self.leg_of[b] == -1 or (self.leg_of[b] != self.leg_of[a] and self.leg_link[b] in SELF_COLLISION_LINKS):
+                    if self.leg_of[b] == -1 or a < b:
+                        pairs.append((a, b))
+        return np.array(sorted(set(pairs)), dtype=np.int64).reshape(-1, 2)
+
+    def placements_fast(self, talos: TalosModel, root_R: np.ndarray, root_p: np.ndarray,
+                        leg_q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World placements of all geometries by NumPy forward kinematics.
+
+        The upper body is rigid at half-sitting, so its geometries follow the root;
+        leg geometries follow the chain of `ik.py` eq. (1)-(3).
+
+        Args:
+            talos: the model.
+            root_R: [3, 3] world_R_root; root_p: [3] root position, world, m.
+            leg_q: [2, 6] leg joints, rad.
+
+        Returns:
+            (R [G, 3, 3], p [G, 3]) world placements of the geometries.
+        """
+        oMroot = np.eye(4)
+        oMroot[:3, :3] = root_R
+        oMroot[:3, 3] = root_p
+        oMg = oMroot @ self.rootMg_upper
+        for side in (LEFT, RIGHT):
+            leg = talos.legs[side]
+            q = leg_q[side]
+            frames = _leg_joint_frames(leg.hip_offset, leg.thigh, leg.shin, q)  # [6, 4, 4] root frame
+            for g in talos.leg_geom_ids[side]:
+                oMg[g] = oMroot @ frames[self.leg_link[g] - 1] @ self.joint_geom[g]
+        return oMg[:, :3, :3], oMg[:, :3, 3]
+
+    def placements_pinocchio(self, talos: TalosModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World placements of all geometries by Pinocchio for configuration q [39]."""
+        import pinocchio as pin
+
+        pin.updateGeometryPlacements(talos.model, talos.data, talos.geom_model, talos.geom_data, q)
+        oMg = np.array([talos.geom_data.oMg[g].homogeneous for g in range(len(self.names))])
+        return oMg[:, :3, :3], oMg[:, :3, 3]
+
+    def world_aabb(self, rot: np.ndarray, pos: np.ndarray) -> np.ndarray:
+        """[G, 2, 3] world bounding boxes of the geometries at placements (rot [G,3,3], pos [G,3])."""
+        center = np.einsum("gij,gj->gi", rot, self.local_center) + pos
+        half = np.einsum("gij,gj->gi", np.abs(rot), self.local_half)
+        return np.stack([center - half, center + half], axis=1)
+
+    def terrain_contacts(self, rot: np.ndarray, pos: np.ndarray, terrain: TerrainCollision,
+                         first_only: bool = True) -> list[tuple[int, int]]:
+        """Geometry/terrain-box pairs in collision.
+
+        Args:
+            rot: [G, 3, 3], pos: [G, 3] geometry placements, world.
+            terrain: the terrain's coal objects.
+            first_only: stop at the first collision.
+
+        Returns:
+            list of (geometry index, box index) in collision (empty: collision-free).
+        """
+        import coal
+
+        if len(terrain.aabb) == 0:
+            return []
+        aabb = self.world_aabb(rot, pos)
+        overlap = np.all((aabb[:, None, 0] <= terrain.aabb[None, :, 1]) &
+                         (aabb[:, None, 1] >= terrain.aabb[None, :, 0]), axis=2)
+        hits = []
+        request = coal.CollisionRequest()
+        result = coal.CollisionResult()
+        for g, b in zip(*np.nonzero(overlap)):
+            result.clear()
+            tf = coal.Transform3s(rot[g], pos[g])
+            if coal.collide(self.geometries[g], tf, terrain.shapes[b], terrain.transforms[b], request, result):
+                hits.append((int(g), int(b)))
+                if first_only:
+                    break
+        return hits
+
+    def self_contacts(self, rot: np.ndarray, pos: np.ndarray, first_only: bool = True) -> list[tuple[int, int]]:
+        """Self-collision pairs (legs vs legs, legs vs upper body) in collision, same conventions."""
+        import coal
+
+        aabb = self.world_aabb(rot, pos)
+        a, b = self.self_pairs[:, 0], self.self_pairs[:, 1]
+        overlap = np.all((aabb[a, 0] <= aabb[b, 1]) & (aabb[a, 1] >= aabb[b, 0]), axis=1)
+        hits = []
+        request = coal.CollisionRequest()
+        result = coal.CollisionResult()
+        for ga, gb in self.self_pairs[overlap]:
+            result.clear()
+            if coal.collide(self.geometries[ga], coal.Transform3s(rot[ga], pos[ga]),
+                            self.geometries[gb], coal.Transform3s(rot[gb], pos[gb]), request, result):
+                hits.append((int(ga), int(gb)))
+                if first_only:
+                    break
+        return hits
+
+
+def _leg_joint_frames(hip_offset: np.ndarray, thigh: float, shin: float, q: np.ndarray) -> np.ndarray:
+    """[6, 4, 4] root-frame placements of a leg's six joint frames (after each joint's rotation)."""
+    c, s = np.cos(q), np.sin(q)
+    rot = np.zeros((6, 3, 3))
+    for k, axis in enumerate((2, 0, 1, 1, 1, 0)):
+        i, j = [(1, 2), (2, 0), (0, 1)][axis]
+        rot[k, axis, axis] = 1.0
+        rot[k, i, i] = c[k]
+        rot[k, j, j] = c[k]
+        rot[k, i, j] = -s[k]
+        rot[k, j, i] = s[k]
+    offsets = (hip_offset, np.zeros(3), np.zeros(3), np.array([0.0, 0.0, -thigh]),
+               np.array([0.0, 0.0, -shin]), np.zeros(3))
+    frames = np.empty((6, 4, 4))
+    current = np.eye(4)
+    for k in range(6):
+        step = np.eye(4)
+        step[:3, :3] = rot[k]
+        step[:3, 3] = offsets[k]
+        current = current @ step
+        frames[k] = current
+    return frames
+
+
+_ROBOT_CACHE: dict = {}
+
+
+def robot_collision(talos: TalosModel) -> RobotCollision:
+    """RobotCollision of `talos`, built once per model object."""
+    key = id(talos)
+    if key not in _ROBOT_CACHE:
+        _ROBOT_CACHE[key] = RobotCollision(talos)
+    return _ROBOT_CACHE[key]

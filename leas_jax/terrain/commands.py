@@ -127,8 +127,7 @@ def draw_terrain(terrain: Terrain):
     width = 8.0
     figure, axes = plt.subplots(figsize=(width, max(3.0, width * (ymax - ymin) / (xmax - xmin))),
                                 layout="constrained")
-    cmap = plt.get_cmap("viridis").copy()
-    cmap.set_bad("#202020")
+    cmap = plt.get_cmap("viridis").with_extremes(bad="#202020")
     # heights[i, j] is at (x_i, y_j): transpose so that rows are y for imshow.
     image = axes.imshow(shown.T, origin="lower", extent=extent, cmap=cmap, interpolation="nearest")
     figure.colorbar(image, ax=axes, label=f"height (m); void (z = {terrain.void_height:g}) in black",

@@ -42,8 +42,13 @@ def terrain_to_mjcf(terrain: Terrain) -> str:
         "  <visual>",
         '    <map znear="0.001" zfar="1000"/>',
         "  </visual>",
+        # mjx.ray (mujoco-mjx 3.17) indexes mat_rgba by geom_matid and fails on a model
+        # without materials: every geom gets one.
+        "  <asset>",
+        '    <material name="terrain" rgba="0.62 0.60 0.55 1"/>',
+        "  </asset>",
         "  <default>",
-        '    <geom type="box" rgba="0.62 0.60 0.55 1"/>',
+        '    <geom type="box" material="terrain"/>',
         "  </default>",
         "  <worldbody>",
         f'    <light pos="{_fmt([(xmin + xmax) / 2, (ymin + ymax) / 2, 10.0])}" dir="0 0 -1" directional="true"/>',

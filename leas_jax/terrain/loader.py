@@ -215,8 +215,10 @@ def _toml_type(value) -> str:
         return "a boolean"
     if isinstance(value, str):
         return "a string"
-    if isinstance(value, (int, float)):
-        return "a number"
+    if isinstance(value, int):
+        return "an integer"
+    if isinstance(value, float):
+        return "a float"
     if isinstance(value, list):
         return "an array"
     if isinstance(value, dict):

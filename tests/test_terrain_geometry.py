@@ -155,6 +155,24 @@ def test_height_at_agrees_with_raster_on_grid_points():
     assert terrain.height_at([0.5, 0.4]).shape == ()
 
 
+def test_height_at_many_points_matches_brute_force():
+    # height_at buckets points by tile; compare with every box tested on every point,
+    # including points outside the bounds and on the tile grid
+    rng = np.random.default_rng(1)
+    boxes = [Box(rng.uniform(0, 5, 3), rng.uniform(0.1, 1.5, 3), rng.uniform(-0.4, 0.4, 3)) for _ in range(40)]
+    terrain = make_terrain(boxes, bounds=((0.0, 0.0), (5.0, 5.0)))
+    xy = np.concatenate([rng.uniform(-1.0, 6.0, size=(20000, 2)), np.mgrid[0:5.5:0.5, 0:5.5:0.5].reshape(2, -1).T])
+    top = np.max([box.column_top(xy[:, 0], xy[:, 1]) for box in boxes], axis=0)
+    expected = np.where(np.isfinite(top), top, -2.0)
+    assert np.mean(expected > -2.0) > 0.3
+    np.testing.assert_array_equal(terrain.height_at(xy), expected)
+    assert terrain.height_at(np.zeros((0, 2))).shape == (0,)
+    with pytest.raises(TerrainError, match="nan or inf"):
+        terrain.height_at([[np.nan, 1.0]])
+    with pytest.raises(TerrainError, match=r"shape \(3,\)"):
+        terrain.height_at([1.0, 2.0, 3.0])
+
+
 def test_raster_of_a_large_box_is_chunked_and_correct():
     # 2001 x 2001 = 4 million points under one box: more than one chunk of 2^20 points
     terrain = make_terrain([Box([20.0, 20.0, -0.5], [40.0, 40.0, 1.0])], bounds=((0.0, 0.0), (40.0, 40.0)),

@@ -7,7 +7,6 @@ metres, z up.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -325,20 +324,28 @@ class Terrain:
         """Exact terrain heights by vertical ray cast on the boxes.
 
         Args:
-            xy: [N, 2] (or [2]) world positions, m.
+            xy: [..., 2] world positions, m (e.g. [N, 2] or [2]).
 
         Returns:
-            [N] (or scalar) float64 heights, void_height where no box is hit.
+            [...] float64 heights, void_height where no box is hit.
+
+        Raises:
+            TerrainError: xy not of shape [..., 2] or not finite.
         """
         points = np.asarray(xy, dtype=np.float64)
+        if points.shape[-1:] != (2,):
+            raise TerrainError(f"height_at: xy of shape {points.shape}: the last axis must hold (x, y)")
         flat = points.reshape(-1, 2)
+        if not np.all(np.isfinite(flat)):
+            raise TerrainError("height_at: xy holds nan or inf")
         top = np.full(len(flat), -np.inf)
+        tiles = _PointTiles(flat)
         for box in self.boxes:
             lo, hi = box.aabb()[:, :2]
-            inside = np.all((flat >= lo - _EDGE_TOL) & (flat <= hi + _EDGE_TOL), axis=1)
-            if np.any(inside):
-                sel = flat[inside]
-                top[inside] = np.maximum(top[inside], box.column_top(sel[:, 0], sel[:, 1]))
+            candidates = tiles.within(lo - _EDGE_TOL, hi + _EDGE_TOL)
+            if len(candidates):
+                sel = flat[candidates]
+                top[candidates] = np.maximum(top[candidates], box.column_top(sel[:, 0], sel[:, 1]))
         heights = np.where(np.isfinite(top), top, self.void_height)
         return heights.reshape(points.shape[:-1])
 
@@ -400,6 +407,39 @@ class Terrain:
         export_terrain(self, path)
 
 
+class _PointTiles:
+    """Points sorted by square tile, to find those inside an axis-aligned rectangle
+    without scanning them all (height_at on many points and many boxes)."""
+
+    TILE = 0.5  # m, about a quarter of a typical box footprint
+
+    def __init__(self, xy: np.ndarray):
+        """xy: [N, 2] world points."""
+        self.xy = xy
+        self.origin = xy.min(axis=0) if len(xy) else np.zeros(2)
+        cells = np.floor((xy - self.origin) / self.TILE).astype(np.int64)
+        self.width = int(cells[:, 0].max()) + 1 if len(xy) else 1
+        self.height = int(cells[:, 1].max()) + 1 if len(xy) else 1
+        ids = cells[:, 1] * self.width + cells[:, 0]
+        self.order = np.argsort(ids, kind="stable")
+        self.ids = ids[self.order]
+
+    def within(self, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """Indices of the points with lo <= xy <= hi (lo, hi: [2] world corners)."""
+        c0 = np.floor((lo - self.origin) / self.TILE).astype(np.int64)
+        c1 = np.floor((hi - self.origin) / self.TILE).astype(np.int64)
+        c0 = np.maximum(c0, 0)
+        c1 = np.minimum(c1, [self.width - 1, self.height - 1])
+        if np.any(c0 > c1):
+            return np.zeros(0, dtype=np.int64)
+        rows = np.arange(c0[1], c1[1] + 1) * self.width
+        starts = np.searchsorted(self.ids, rows + c0[0], side="left")
+        ends = np.searchsorted(self.ids, rows + c1[0], side="right")
+        candidates = np.concatenate([self.order[a:b] for a, b in zip(starts, ends)])
+        inside = np.all((self.xy[candidates] >= lo) & (self.xy[candidates] <= hi), axis=1)
+        return candidates[inside]
+
+
 def raster_shape(bounds, resolution: float) -> tuple[int, int]:
     """(nx, ny) raster points of bounds [2, 2] at `resolution` m: round(extent/res) + 1 per axis."""
     extent = np.asarray(bounds, dtype=np.float64)[1] - np.asarray(bounds, dtype=np.float64)[0]
@@ -440,7 +480,3 @@ def rasterize(boxes, bounds, resolution: float, void_height: float) -> np.ndarra
             np.maximum(top[a:b, j0:j1 + 1], column, out=top[a:b, j0:j1 + 1])
     return np.where(np.isfinite(top), top, void_height).astype(np.float32)
 
-
-def replace(terrain: Terrain, **changes) -> Terrain:
-    """Copy of a terrain with some fields changed (the raster cache is not carried over)."""
-    return dataclasses.replace(terrain, **changes)

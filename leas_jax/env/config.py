@@ -1,0 +1,88 @@
+"""Static configuration of the LeaS environment.
+
+Every default is the paper's value or the one DESIGN.md §5 gives, with its
+unit and source. These dataclasses are frozen and hashable: they fix shapes
+and are baked into compiled code (gymnax's static `EnvParams` habit).
+"""
+
+from dataclasses import dataclass, field
+
+import math
+
+
+@dataclass(frozen=True)
+class ReachabilityConfig:
+    """Cylinders of the reachability condition, root frame (origin at base_link, z up, yaw only).
+
+    Defaults from DESIGN.md §5: the `talos_trunk` and `talos_*leg_rom` volumes of
+    the HPP Talos data, approximated by vertical cylinders.
+    """
+
+    trunk_radius: float = 0.30  # m, trunk cylinder radius (talos_trunk boxes span x ±0.2, y ±0.3)
+    trunk_bottom: float = -0.63  # m below the root: hip
+    trunk_top: float = 0.60  # m above the root: head
+    leg_radius: float = 0.25  # m, radius of each leg reachability cylinder (talos_*leg_rom)
+    leg_lateral_offset: float = 0.085  # m, leg cylinder centres at (0, ±offset) in the root frame
+    leg_bottom: float = -1.06  # m below the root: lowest reachable sole height
+    leg_top: float = -0.54  # m below the root: highest reachable sole height
+
+
+@dataclass(frozen=True)
+class HeightmapConfig:
+    """The 11 x 7 heightmap of the observation (paper §III-B, Fig. 3; thesis of the first author)."""
+
+    forward_step: float = 0.08  # m, spacing of the 9 points ahead
+    forward_count: int = 9
+    backward_step: float = 0.20  # m, spacing of the 2 points behind
+    backward_count: int = 2
+    lateral_step: float = 0.15  # m, spacing of the 7 columns, y = 0.15 j, j = -3..3
+    lateral_half_count: int = 3
+    clip_low: float = -1.4  # m, heights are (terrain - root z) clipped to [clip_low, clip_high]
+    clip_high: float = -0.2  # m
+
+    @property
+    def size(self) -> int:
+        return (self.forward_count + self.backward_count) * (2 * self.lateral_half_count + 1)
+
+
+@dataclass(frozen=True)
+class RewardWeights:
+    """Weights of the reward terms (paper Table I)."""
+
+    direction: float = 1.0  # w_dir
+    orientation: float = 0.4  # w_ori
+    effort_orientation: float = 0.1  # w_eff_ori
+    effort_acceleration: float = 0.1  # w_eff_acc
+    alive: float = 1.0  # w_alive
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """LeaS MDP parameters (DESIGN.md §5)."""
+
+    timestep: float = 0.10  # s, paper Table I
+    episode_length: int = 400  # steps, paper Table I
+    target_speed: float = 0.18  # m/s, paper §IV
+    v_max: float = 0.30  # m/s, HPP Talos scripts (vMax)
+    a_max: float = 0.10  # m/s^2 per unit action norm, HPP Talos scripts (aMax)
+    omega_max: float = math.pi / 9.0  # rad/s, thesis of the first author
+    # Actions accelerate the root in its own (yaw-rotated) frame. The paper says
+    # "accelerations of the robot on each axis" without a frame; the root frame
+    # makes the policy invariant to the world yaw, as its observation already is.
+    actions_in_root_frame: bool = True
+    reset_max_speed: float = 0.07  # m/s, initial speed along the heading drawn in [0, this]
+    # Nominal height of base_link above the ground at reset. Talos half-sitting
+    # puts base_link about 1.0 m above its soles (measured on the
+    # example-robot-data model by leas_jax.contacts).
+    nominal_root_height: float = 1.0  # m
+    target_reached_distance: float = 0.20  # m, epsilon of the evaluation termination (DESIGN §5)
+    stop_at_target: bool = False  # evaluation mode: end an episode when the root is within epsilon
+    reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
+    reachability: ReachabilityConfig = field(default_factory=ReachabilityConfig)
+    heightmap: HeightmapConfig = field(default_factory=HeightmapConfig)
+    rewards: RewardWeights = field(default_factory=RewardWeights)
+
+    @property
+    def observation_size(self) -> int:
+        """3 (velocity, root frame) + 1 (target angle) + heightmap."""
+        return 4 + self.heightmap.size

@@ -1,0 +1,201 @@
+"""`LeasEnv`: the LeaS MDP as a Brax environment (one env, no batch axis).
+
+The env composes the pure functions of `kinematics`, `heightmap`,
+`reachability` and `reward`. Its terrain is a `Heightfield` pytree held as
+data: build the env inside a jitted function from a traced field
+(`env.with_field(field)`) to keep the rasters out of the compiled constants.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+
+import jax
+import jax.numpy as jnp
+from flax import struct
+
+# brax imports mujoco.mjx, whose optional GPU backend prints "Failed to import
+# warp" on machines without it; keep that noise out of the command line.
+with contextlib.redirect_stdout(io.StringIO()):
+    from brax.envs.base import Env, State
+
+from leas_jax.env import heightmap, kinematics, reachability, reward
+from leas_jax.env.config import EnvConfig
+from leas_jax.env.field import Heightfield, sample_bilinear
+
+
+@struct.dataclass
+class RootState:
+    """Guide-path state of one environment (Brax `State.pipeline_state`).
+
+    Attributes:
+        pos: [3] world position of base_link (m).
+        vel: [3] world velocity (m/s).
+        yaw: [] heading (rad).
+        target_dir: [2] unit target direction, world, horizontal.
+        target_point: [2] world target (x, y); used when `follow_point`.
+        follow_point: bool[]; True: the target direction points at `target_point` each step.
+        steps: int32[] steps taken in this episode.
+        rng: [2] uint32 PRNG key for the next reset.
+    """
+
+    pos: jax.Array
+    vel: jax.Array
+    yaw: jax.Array
+    target_dir: jax.Array
+    target_point: jax.Array
+    follow_point: jax.Array
+    steps: jax.Array
+    rng: jax.Array
+
+    @property
+    def pose(self) -> jax.Array:
+        """[4] (x, y, z, yaw), world."""
+        return jnp.concatenate([self.pos, self.yaw[None]])
+
+
+def _unit(v: jax.Array) -> jax.Array:
+    return v / jnp.maximum(jnp.linalg.norm(v), 1e-9)
+
+
+def _heading(yaw: jax.Array) -> jax.Array:
+    return jnp.stack([jnp.cos(yaw), jnp.sin(yaw)])
+
+
+class LeasEnv(Env):
+    """LeaS guide-path environment (paper §III, DESIGN.md §5).
+
+    Observation [81]: root-frame velocity [3], target angle [1] (target
+    direction minus heading, wrapped to [-pi, pi)), heightmap [77].
+    Action [4]: (a_x, a_y, a_z, omega) in [-1, 1].
+    Episodes end on an invalid pose (reachability), after `episode_length`
+    steps (info['truncation'] = 1), and with `stop_at_target` when the root is
+    within `target_reached_distance` of the target point.
+    """
+
+    def __init__(self, field: Heightfield, config: EnvConfig = EnvConfig()):
+        self.field = field
+        self.config = config
+
+    def with_field(self, field: Heightfield) -> "LeasEnv":
+        """The same env on another (possibly traced) heightfield."""
+        return LeasEnv(field, self.config)
+
+    @property
+    def observation_size(self) -> int:
+        return self.config.observation_size
+
+    @property
+    def action_size(self) -> int:
+        return 4
+
+    @property
+    def backend(self) -> str:
+        return "leas"
+
+    # -- observation -------------------------------------------------------
+    def observe(self, root: RootState) -> jax.Array:
+        """[81] observation of a root state."""
+        vel_root = jnp.concatenate([kinematics.rotate_z(root.vel[:2], -root.yaw), root.vel[2:]])
+        target_angle = kinematics.wrap_angle(jnp.arctan2(root.target_dir[1], root.target_dir[0]) - root.yaw)
+        hmap = heightmap.sample(self.field, root.pose, self.config.heightmap)
+        return jnp.concatenate([vel_root, target_angle[None], hmap])
+
+    def _state(self, root: RootState, reward_value, done, metrics, truncation) -> State:
+        return State(pipeline_state=root, obs=self.observe(root), reward=reward_value, done=done,
+                     metrics=metrics, info={"truncation": truncation})
+
+    def _zero_metrics(self) -> dict:
+        names = ("direction", "orientation", "effort_orientation", "effort_acceleration", "alive")
+        metrics = {f"reward/{n}": jnp.zeros(()) for n in names}
+        metrics.update(invalid=jnp.zeros(()), reached=jnp.zeros(()))
+        return metrics
+
+    # -- reset -------------------------------------------------------------
+    def reset(self, rng: jax.Array) -> State:
+        """Fresh random start: valid position near a spawn point, random yaw,
+        speed along the heading in [0, reset_max_speed], random target direction."""
+        root = self.random_root(rng)
+        return self._state(root, jnp.zeros(()), jnp.zeros(()), self._zero_metrics(), jnp.zeros(()))
+
+    def random_root(self, rng: jax.Array) -> RootState:
+        """Root state of a fresh random start (no observation; see `reset`).
+
+        One uniform draw feeds every random quantity (each threefry call
+        costs about as much as a reachability test on a CPU).
+        """
+        cfg = self.config
+        next_rng, key = jax.random.split(rng)
+        n = cfg.reset_attempts
+        u = jax.random.uniform(key, (4 * n + 2,))
+        cand, speed_u, target_u = u[:4 * n].reshape(n, 4), u[-2], u[-1]
+        count = self.field.spawn_xy.shape[0]
+        idx = jnp.minimum((cand[:, 0] * count).astype(jnp.int32), count - 1)
+        jitter = (cand[:, 1:3] - 0.5) * self.field.spawn_spacing
+        # the last candidate is the spawn point itself (masks, not scatters: scatters are slow on CPU)
+        last = jnp.arange(n) == n - 1
+        xy = self.field.spawn_xy[idx] + jnp.where(last[:, None], 0.0, jitter)
+        yaw = (2.0 * cand[:, 3] - 1.0) * jnp.pi
+        z = sample_bilinear(self.field, xy) + cfg.nominal_root_height
+        poses = jnp.concatenate([xy, z[:, None], yaw[:, None]], axis=1)
+        ok = jax.vmap(lambda p: reachability.valid(self.field, p, cfg.reachability))(poses)
+        ok = ok | last  # spawn points are valid for every yaw by construction
+        pose = poses[jnp.argmax(ok)]
+        target_angle = (2.0 * target_u - 1.0) * jnp.pi
+        return self._root(pose, speed_u * cfg.reset_max_speed, _heading(target_angle), jnp.zeros(2),
+                          jnp.asarray(False), next_rng)
+
+    def _root(self, pose, speed, target_dir, target_point, follow_point, rng) -> RootState:
+        return RootState(pos=pose[:3], vel=jnp.concatenate([speed * _heading(pose[3]), jnp.zeros(1)]),
+                         yaw=pose[3], target_dir=target_dir, target_point=target_point,
+                         follow_point=follow_point, steps=jnp.zeros((), jnp.int32), rng=rng)
+
+    def reset_to(self, pose: jax.Array, speed, target_dir=None, target_point=None, rng=None) -> State:
+        """Start from a given pose.
+
+        Args:
+            pose: [4] (x, y, z, yaw), world.
+            speed: [] initial speed along the heading (m/s).
+            target_dir: [2] world direction to follow (normalised here), or
+            target_point: [2] world point to walk to (the direction is recomputed each step).
+            rng: PRNG key stored for later resets (default: key 0).
+        """
+        if (target_dir is None) == (target_point is None):
+            raise ValueError("give exactly one of target_dir and target_point")
+        pose = jnp.asarray(pose, jnp.float32)
+        follow = target_point is not None
+        point = jnp.asarray(target_point if follow else jnp.zeros(2), jnp.float32)
+        direction = _unit(point - pose[:2]) if follow else _unit(jnp.asarray(target_dir, jnp.float32))
+        root = self._root(pose, jnp.asarray(speed, jnp.float32), direction, point, jnp.asarray(follow),
+                          jax.random.PRNGKey(0) if rng is None else rng)
+        return self._state(root, jnp.zeros(()), jnp.zeros(()), self._zero_metrics(), jnp.zeros(()))
+
+    # -- step --------------------------------------------------------------
+    def step(self, state: State, action: jax.Array) -> State:
+        root, reward_value, done, metrics, truncation = self.transition(state.pipeline_state, action)
+        return self._state(root, reward_value, done, metrics, truncation)
+
+    def transition(self, root: RootState, action: jax.Array):
+        """One step without the observation.
+
+        Returns:
+            (root, reward [], done [] float, metrics dict, truncation [] float).
+        """
+        cfg = self.config
+        accel, omega = kinematics.scale_action(action, root.yaw, cfg)
+        pos, vel, yaw = kinematics.integrate(root.pos, root.vel, root.yaw, accel, omega, cfg)
+        target_dir = jnp.where(root.follow_point, _unit(root.target_point - pos[:2]), root.target_dir)
+        steps = root.steps + 1
+        root = root.replace(pos=pos, vel=vel, yaw=yaw, target_dir=target_dir, steps=steps)
+
+        terms = reward.terms(vel, yaw, action, target_dir, cfg)
+        ok = reachability.valid(self.field, root.pose, cfg.reachability)
+        reached = root.follow_point & (jnp.linalg.norm(root.target_point - pos[:2]) < cfg.target_reached_distance)
+        reached = reached & cfg.stop_at_target
+        timeout = steps >= cfg.episode_length
+        done = (~ok) | reached | timeout
+        truncation = (timeout & ok & ~reached).astype(jnp.float32)
+        metrics = {f"reward/{k}": v for k, v in terms.items()}
+        metrics.update(invalid=(~ok).astype(jnp.float32), reached=reached.astype(jnp.float32))
+        return root, reward.total(terms, cfg), done.astype(jnp.float32), metrics, truncation

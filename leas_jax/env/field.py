@@ -1,0 +1,196 @@
+"""The terrain as JAX data: heights and reachability rasters on a regular grid.
+
+`Heightfield` is a pytree passed to the pure functions (never a constant baked
+into a closure). Host code builds it once per terrain with
+`heightfield_from_terrain`; everything else here is jittable.
+
+Grid convention (same as `Terrain.raster()`): `heights[i, j]` is the terrain
+height at world point `(x0 + i * res, y0 + j * res)`. Outside the grid the
+terrain is `void_height` (the void the boxes stand over).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import jax
+import jax.numpy as jnp
+from flax import struct
+from scipy import ndimage
+
+from leas_jax.env.config import EnvConfig, ReachabilityConfig
+
+
+@struct.dataclass
+class Heightfield:
+    """Terrain rasters, world frame.
+
+    Attributes:
+        heights: [nx, ny] terrain height (m).
+        trunk_max: [nx, ny] highest terrain point within `trunk_radius` of the point.
+        leg_max: [nx, ny] highest terrain point within `leg_radius` of the point.
+        leg_min: [nx, ny] lowest terrain point within `leg_radius` of the point.
+        origin: [2] world (x, y) of `heights[0, 0]`.
+        resolution: [] cell size (m).
+        void_height: [] height outside the grid.
+        spawn_xy: [S, 2] world (x, y) of grid points where a root at nominal
+            height is valid for every yaw; resets draw around them.
+        spawn_spacing: [] spacing of the spawn candidates (m); resets jitter within it.
+    """
+
+    heights: jax.Array
+    trunk_max: jax.Array
+    leg_max: jax.Array
+    leg_min: jax.Array
+    origin: jax.Array
+    resolution: jax.Array
+    void_height: jax.Array
+    spawn_xy: jax.Array
+    spawn_spacing: jax.Array
+
+
+def _grid_index(field: Heightfield, xy: jax.Array):
+    """Continuous grid coordinates of world points. xy: [..., 2] -> ([...], [...])."""
+    u = (xy[..., 0] - field.origin[0]) / field.resolution
+    v = (xy[..., 1] - field.origin[1]) / field.resolution
+    return u, v
+
+
+def sample_nearest(field: Heightfield, raster: jax.Array, xy: jax.Array) -> jax.Array:
+    """Value of `raster` at the grid point nearest to each world point; void outside.
+
+    Args:
+        field: the heightfield (for origin, resolution, void height).
+        raster: [nx, ny] one of the field's rasters.
+        xy: [..., 2] world points.
+
+    Returns:
+        [...] raster values.
+    """
+    nx, ny = raster.shape
+    u, v = _grid_index(field, xy)
+    i = jnp.round(u).astype(jnp.int32)
+    j = jnp.round(v).astype(jnp.int32)
+    inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
+    flat = raster.reshape(-1)[jnp.clip(i, 0, nx - 1) * ny + jnp.clip(j, 0, ny - 1)]
+    return jnp.where(inside, flat, field.void_height)
+
+
+def sample_bilinear(field: Heightfield, xy: jax.Array) -> jax.Array:
+    """Terrain height at world points, bilinear between grid points; void outside.
+
+    Bilinear interpolation is exact on planar faces (slopes) away from edges.
+
+    Args:
+        field: the heightfield.
+        xy: [..., 2] world points.
+
+    Returns:
+        [...] heights (m).
+    """
+    heights = field.heights
+    nx, ny = heights.shape
+    u, v = _grid_index(field, xy)
+    inside = (u >= 0) & (u <= nx - 1) & (v >= 0) & (v <= ny - 1)
+    i0 = jnp.clip(jnp.floor(u).astype(jnp.int32), 0, nx - 2)
+    j0 = jnp.clip(jnp.floor(v).astype(jnp.int32), 0, ny - 2)
+    fu = jnp.clip(u - i0, 0.0, 1.0)
+    fv = jnp.clip(v - j0, 0.0, 1.0)
+    flat = heights.reshape(-1)
+    base = i0 * ny + j0
+    h00 = flat[base]
+    h01 = flat[base + 1]
+    h10 = flat[base + ny]
+    h11 = flat[base + ny + 1]
+    h = (h00 * (1 - fu) * (1 - fv) + h10 * fu * (1 - fv)
+         + h01 * (1 - fu) * fv + h11 * fu * fv)
+    return jnp.where(inside, h, field.void_height)
+
+
+def disk_filter(heights: np.ndarray, radius_cells: float, reduce: str, cval: float) -> np.ndarray:
+    """Max or min of `heights` over a disk around every grid point (host, NumPy).
+
+    A disk is a stack of rows; the 2-D filter is the max (min) over row offsets
+    dy of a 1-D filter of half-width floor(sqrt(r^2 - dy^2)) shifted by dy,
+    which costs O(r) 1-D passes instead of O(r^2) per point.
+
+    Args:
+        heights: [nx, ny] raster.
+        radius_cells: disk radius in cells.
+        reduce: "max" or "min".
+        cval: value outside the raster (the void height).
+
+    Returns:
+        [nx, ny] filtered raster.
+    """
+    filt1d = ndimage.maximum_filter1d if reduce == "max" else ndimage.minimum_filter1d
+    combine = np.maximum if reduce == "max" else np.minimum
+    r = int(np.floor(radius_cells))
+    padded = np.pad(heights, r, mode="constant", constant_values=cval)
+    out = None
+    for dy in range(-r, r + 1):
+        half = int(np.floor(np.sqrt(max(radius_cells**2 - dy**2, 0.0))))
+        rows = filt1d(padded, size=2 * half + 1, axis=0, mode="constant", cval=cval)
+        shifted = rows[r:-r or None, r + dy: r + dy + heights.shape[1]]
+        out = shifted if out is None else combine(out, shifted)
+    return out
+
+
+def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, leg_max: np.ndarray,
+                  leg_min: np.ndarray, resolution: float, config: EnvConfig,
+                  spacing: float) -> np.ndarray:
+    """Grid indices [S, 2] where a root at nominal height is valid for every yaw.
+
+    The leg cylinders turn with the yaw around the root; a point is kept when a
+    cylinder of radius (leg_radius - lateral offset) around it already reaches
+    the ground, which holds for both legs whatever the yaw. (Host, NumPy.)
+    """
+    reach = config.reachability
+    stride = max(int(round(spacing / resolution)), 1)
+    z = heights + config.nominal_root_height
+    inner = max(reach.leg_radius - reach.leg_lateral_offset, resolution) / resolution
+    inner_max = disk_filter(heights, inner, "max", -np.inf)
+    inner_min = disk_filter(heights, inner, "min", np.inf)
+    ok = (trunk_max < z + reach.trunk_bottom)
+    ok &= (inner_max >= z + reach.leg_bottom) & (inner_min <= z + reach.leg_top)
+    # keep away from the grid border so that jittered resets stay inside
+    ok[:stride, :] = ok[-stride:, :] = False
+    ok[:, :stride] = ok[:, -stride:] = False
+    sub = np.zeros_like(ok)
+    sub[::stride, ::stride] = True
+    del leg_max, leg_min  # the inner disk test above implies the per-leg test
+    return np.argwhere(ok & sub)
+
+
+def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void_height: float,
+                            config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10) -> Heightfield:
+    """Build the JAX heightfield and its reachability rasters (host only, not jittable).
+
+    Args:
+        heights: [nx, ny] terrain heights, heights[i, j] at origin + (i, j) * resolution.
+        origin: (x0, y0) world.
+        resolution: cell size (m).
+        void_height: height outside the grid (m).
+        config: environment configuration (cylinder radii, nominal root height).
+        spawn_spacing: spacing of reset candidates (m).
+    """
+    heights = np.asarray(heights, dtype=np.float32)
+    reach: ReachabilityConfig = config.reachability
+    trunk_max = disk_filter(heights, reach.trunk_radius / resolution, "max", void_height)
+    leg_max = disk_filter(heights, reach.leg_radius / resolution, "max", void_height)
+    leg_min = disk_filter(heights, reach.leg_radius / resolution, "min", void_height)
+    spawn_ij = _spawn_points(heights, trunk_max, leg_max, leg_min, resolution, config, spawn_spacing)
+    if len(spawn_ij) == 0:
+        raise ValueError("the terrain has no valid spawn position for the root at nominal height")
+    spawn_xy = np.asarray(origin, dtype=np.float32) + spawn_ij.astype(np.float32) * resolution
+    f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
+    return Heightfield(
+        heights=f32(heights), trunk_max=f32(trunk_max), leg_max=f32(leg_max), leg_min=f32(leg_min),
+        origin=f32(origin), resolution=f32(resolution), void_height=f32(void_height),
+        spawn_xy=f32(spawn_xy), spawn_spacing=f32(spawn_spacing),
+    )
+
+
+def heightfield_from_terrain(terrain, config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10) -> Heightfield:
+    """Heightfield of a `leas_jax.terrain.Terrain` (host only, not jittable)."""
+    return heightfield_from_raster(terrain.raster(), terrain.bounds[0], terrain.resolution,
+                                   terrain.void_height, config, spawn_spacing)

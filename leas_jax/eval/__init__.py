@@ -1,0 +1,1 @@
+"""Evaluation: geometric metrics, reports (and, later, the paper's scenarios)."""

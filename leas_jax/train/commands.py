@@ -1,0 +1,90 @@
+"""`leas train` and `leas run`."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from leas_jax.errors import UsageError
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text.replace("_", ""))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def _add_training_arguments(parser) -> None:
+    from leas_jax.train.config import PRESETS
+
+    parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
+                        help="smoke (< 1 min), quick (~10 min on 2 cores), paper (80 M steps)")
+    parser.add_argument("--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)")
+    parser.add_argument("--seed", type=int, default=None, help="PRNG seed (default: the preset's, 0)")
+    parser.add_argument("--terrain", metavar="FILE", default=None,
+                        help="training terrain (default terrains/training_arena.toml)")
+    parser.add_argument("--timesteps", type=_positive_int, default=None, help="override the preset's env steps")
+    parser.add_argument("--num-envs", type=_positive_int, default=None, help="override the number of parallel envs")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def config_from_args(args):
+    """TrainConfig of the parsed `leas train` / `leas run` arguments."""
+    from leas_jax.train.config import preset
+
+    overrides = {}
+    if args.seed is not None:
+        overrides["seed"] = args.seed
+    if args.terrain is not None:
+        if not Path(args.terrain).is_file():
+            raise UsageError(f"--terrain: no such file: {args.terrain}")
+        overrides["terrain"] = args.terrain
+    if args.timesteps is not None:
+        overrides["num_timesteps"] = args.timesteps
+    if args.num_envs is not None:
+        overrides["num_envs"] = args.num_envs
+    return preset(args.preset, **overrides)
+
+
+def cmd_train(args) -> int:
+    from leas_jax.train.loop import train
+
+    config = config_from_args(args)
+    result = train(config, args.out, progress=not args.no_progress)
+    metrics = result.metrics
+    print(f"trained {result.env_steps:,} env steps in {result.wall_s:.0f} s "
+          f"({metrics.get('sps', float('nan')):,.0f} steps/s); policy: {result.policy_path}")
+    return 0
+
+
+def cmd_run(args) -> int:
+    from leas_jax.eval.report import write_report
+    from leas_jax.train.loop import train
+
+    config = config_from_args(args)
+    result = train(config, args.out, progress=not args.no_progress)
+    report = write_report(Path(args.out), n_episodes=args.eval_episodes)
+    print(f"report: {report}")
+    return 0
+
+
+def register(subparsers) -> None:
+    train = subparsers.add_parser("train", help="train a LeaS policy (geometric PPO)",
+                                  description="Train a LeaS policy with Brax PPO on the training arena. "
+                                              "Writes config.json, checkpoints/, policy.pkl, metrics.jsonl "
+                                              "and tb/ into --out; an interrupted run resumes from its last "
+                                              "checkpoint when started again with the same --out.")
+    _add_training_arguments(train)
+    train.set_defaults(func=cmd_train)
+
+    run = subparsers.add_parser("run", help="the main job: train, evaluate, write report.md",
+                                description="Train (resuming if possible), evaluate the policy and write "
+                                            "<out>/report.md with learning curves and rollout plots.")
+    _add_training_arguments(run)
+    run.add_argument("--eval-episodes", type=_positive_int, default=256,
+                     help="episodes per evaluation metric (default 256)")
+    run.set_defaults(func=cmd_run)

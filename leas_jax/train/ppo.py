@@ -1,0 +1,173 @@
+"""Geometric PPO training, built from Brax's PPO pieces.
+
+Brax's networks, loss (`compute_ppo_loss`), gradient update and running
+statistics, in our own loop so that (1) the terrain heightfield is a traced
+argument rather than a compiled constant, (2) every episode starts from a
+fresh random draw (`FreshResetVmap`), (3) the whole training state (optimizer
+moments, normaliser, env states, PRNG key) is checkpointed and a resumed run
+continues exactly where it stopped, and (4) the planner-in-the-loop mode can
+reuse the same pieces.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import optax
+from brax.training import gradients
+from brax.training.acme import running_statistics, specs
+from brax.training.agents.ppo import losses as ppo_losses
+from brax.training.agents.ppo import networks as ppo_networks
+from brax.training.types import Transition
+from flax import struct
+
+from leas_jax.env import FreshResetVmap, LeasEnv
+from leas_jax.env.field import Heightfield
+from leas_jax.train.config import TrainConfig
+from leas_jax.train.networks import make_networks
+
+
+@struct.dataclass
+class TrainState:
+    """Everything a resumed run needs (batched over envs where it says [B]).
+
+    Attributes:
+        params: policy and value network parameters.
+        optimizer_state: Adam moments.
+        normalizer: observation running statistics.
+        env_state: Brax state of the [B] envs.
+        episode_return: [B] return of the running episode.
+        episode_length: [B] length of the running episode.
+        key: PRNG key.
+        env_steps: int32[] transitions collected so far.
+        iteration: int32[] iterations done so far.
+    """
+
+    params: ppo_losses.PPONetworkParams
+    optimizer_state: Any
+    normalizer: running_statistics.RunningStatisticsState
+    env_state: Any
+    episode_return: jax.Array
+    episode_length: jax.Array
+    key: jax.Array
+    env_steps: jax.Array
+    iteration: jax.Array
+
+
+def make_optimizer(config: TrainConfig) -> optax.GradientTransformation:
+    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(config.learning_rate))
+
+
+def init_state(config: TrainConfig, field: Heightfield) -> TrainState:
+    """Fresh training state for `config` on `field` (jitted inside)."""
+    network = make_networks(config)
+    optimizer = make_optimizer(config)
+    key = jax.random.PRNGKey(config.seed)
+    key, k_policy, k_value, k_env = jax.random.split(key, 4)
+    params = ppo_losses.PPONetworkParams(policy=network.policy_network.init(k_policy),
+                                         value=network.value_network.init(k_value))
+    normalizer = running_statistics.init_state(specs.Array((config.env.observation_size,), jnp.float32))
+
+    @jax.jit
+    def reset(field, keys):
+        return FreshResetVmap(LeasEnv(field, config.env)).reset(keys)
+
+    env_state = reset(field, jax.random.split(k_env, config.num_envs))
+    return TrainState(params=params, optimizer_state=optimizer.init(params), normalizer=normalizer,
+                      env_state=env_state, episode_return=jnp.zeros(config.num_envs),
+                      episode_length=jnp.zeros(config.num_envs), key=key,
+                      env_steps=jnp.zeros((), jnp.int32), iteration=jnp.zeros((), jnp.int32))
+
+
+def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield, key):
+    """Collect [B, T] transitions with the current stochastic policy; episode statistics."""
+    env = FreshResetVmap(LeasEnv(field, config.env))
+    policy = ppo_networks.make_inference_fn(network)((state.normalizer, state.params.policy))
+
+    def step(carry, k):
+        env_state, ep_return, ep_length = carry
+        actions, policy_extras = policy(env_state.obs, k)
+        nstate = env.step(env_state, actions)
+        ep_return = ep_return + nstate.reward
+        ep_length = ep_length + 1
+        done = nstate.done
+        stats = {
+            "episodes": done.sum(),
+            "episode_return_sum": (done * ep_return).sum(),
+            "episode_length_sum": (done * ep_length).sum(),
+            "invalid_episodes": (done * nstate.metrics["invalid"]).sum(),
+            **{k_: v.mean() for k_, v in nstate.metrics.items() if k_.startswith("reward/")},
+            "reward": nstate.reward.mean(),
+        }
+        transition = Transition(
+            observation=env_state.obs, action=actions, reward=nstate.reward, discount=1 - done,
+            next_observation=nstate.obs,
+            extras={"policy_extras": policy_extras, "state_extras": {"truncation": nstate.info["truncation"]}})
+        carry = (nstate, ep_return * (1 - done), ep_length * (1 - done))
+        return carry, (transition, stats)
+
+    carry = (state.env_state, state.episode_return, state.episode_length)
+    (env_state, ep_return, ep_length), (data, stats) = jax.lax.scan(
+        step, carry, jax.random.split(key, config.unroll_length))
+    data = jax.tree.map(lambda x: jnp.swapaxes(x, 0, 1), data)  # [B, T, ...]
+    stats = {k: (v.sum() if k in ("episodes", "episode_return_sum", "episode_length_sum", "invalid_episodes")
+                 else v.mean()) for k, v in stats.items()}
+    return state.replace(env_state=env_state, episode_return=ep_return, episode_length=ep_length), data, stats
+
+
+def _sgd(config: TrainConfig, network, optimizer, state: TrainState, data: Transition, key):
+    """`num_epochs` passes of `num_minibatches` PPO gradient steps over the batch."""
+    loss_fn = functools.partial(
+        ppo_losses.compute_ppo_loss, ppo_network=network, entropy_cost=config.entropy_cost,
+        discounting=config.discounting, reward_scaling=config.reward_scaling,
+        gae_lambda=config.gae_lambda, clipping_epsilon=config.clipping_epsilon,
+        normalize_advantage=True, vf_coefficient=config.vf_coefficient)
+    update = gradients.gradient_update_fn(loss_fn, optimizer, pmap_axis_name=None, has_aux=True)
+
+    def minibatch(carry, inputs):
+        params, opt_state = carry
+        batch, k = inputs
+        (_, metrics), params, opt_state = update(params, state.normalizer, batch, k, optimizer_state=opt_state)
+        return (params, opt_state), metrics
+
+    def epoch(carry, k):
+        k_perm, k_mb = jax.random.split(k)
+        perm = jax.random.permutation(k_perm, config.num_envs)
+        shuffled = jax.tree.map(
+            lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), data)
+        return jax.lax.scan(minibatch, carry, (shuffled, jax.random.split(k_mb, config.num_minibatches)))
+
+    (params, opt_state), metrics = jax.lax.scan(
+        epoch, (state.params, state.optimizer_state), jax.random.split(key, config.num_epochs))
+    metrics = {f"loss/{k}": v.mean() for k, v in metrics.items()}
+    return state.replace(params=params, optimizer_state=opt_state), metrics
+
+
+def make_train_call(config: TrainConfig):
+    """Jitted `(state, field) -> (state, metrics)` running `iterations_per_call` PPO iterations.
+
+    Metrics: per-call means of the per-iteration statistics, plus sums of the
+    episode counters (episodes, episode_return_sum, ...).
+    """
+    network = make_networks(config)
+    optimizer = make_optimizer(config)
+
+    def iteration(state: TrainState, field: Heightfield):
+        key, k_unroll, k_sgd = jax.random.split(state.key, 3)
+        state, data, stats = _unroll(config, network, state, field, k_unroll)
+        state = state.replace(normalizer=running_statistics.update(state.normalizer, data.observation))
+        state, losses = _sgd(config, network, optimizer, state, data, k_sgd)
+        state = state.replace(key=key, env_steps=state.env_steps + config.batch_size,
+                              iteration=state.iteration + 1)
+        return state, {**stats, **losses}
+
+    def call(state: TrainState, field: Heightfield):
+        state, metrics = jax.lax.scan(lambda s, _: iteration(s, field), state, None,
+                                      length=config.iterations_per_call)
+        summed = ("episodes", "episode_return_sum", "episode_length_sum", "invalid_episodes")
+        return state, {k: (v.sum() if k in summed else v.mean()) for k, v in metrics.items()}
+
+    return jax.jit(call, donate_argnums=(0,))

@@ -147,7 +147,7 @@ def ground_pieces(region: Rect, claimed: list[Rect]) -> list[Rect]:
 
 
 def stairs(start: float, lo: float, hi: float, tops, axis: int, direction: int = 1,
-           tread: float = TREAD, bottom: float = FLOOR, last_tread: float | None = None) -> list[BoxSpec]:
+           tread: float = TREAD, bottom: float = FLOOR) -> list[BoxSpec]:
     """A flight of treads, one slab each.
 
     Args:
@@ -158,19 +158,16 @@ def stairs(start: float, lo: float, hi: float, tops, axis: int, direction: int =
         direction: +1 or -1, walking direction along the axis.
         tread: tread depth, m.
         bottom: bottom of the slabs, m.
-        last_tread: depth of the last tread (a landing) if different, m.
 
     Returns:
         one slab per tread, from `start` on, in walking order.
     """
     boxes, pos = [], start
-    tops = list(tops)
-    for k, top in enumerate(tops):
-        depth = last_tread if (last_tread is not None and k == len(tops) - 1) else tread
-        a, b = sorted((pos, pos + direction * depth))
+    for top in tops:
+        a, b = sorted((pos, pos + direction * tread))
         rect = (a, lo, b, hi) if axis == 0 else (lo, a, hi, b)
         boxes.append(slab(rect, top, bottom))
-        pos += direction * depth
+        pos += direction * tread
     return boxes
 
 
@@ -626,7 +623,7 @@ def _eval_circuit() -> tuple:
     vs = [0.7, 1.23, 1.77, 2.3]
     rubble = [slab((us[i], vs[j], us[i + 1], vs[j + 1]), rubble_tops[j][i]) for i in range(4) for j in range(3)]
     step = plateau / 2  # two equal steps down from the plateau (~0.13 m)
-    down = stairs(10.0, 0.5, 2.5, [step], axis=0, last_tread=TREAD)
+    down = stairs(10.0, 0.5, 2.5, [step], axis=0)
     ramp_box = ramp((5.5, 1.5), 0.0, 1.5, angle, 2.0)
     pillars = [_upright((x, y), (0.3, 0.3), 1.5, yaw)
                for x, y, yaw in ((12.2, 3.4, 0.3), (13.9, 2.6, 0.0), (14.3, 5.0, 0.6), (14.0, 6.4, 0.2))]

@@ -106,8 +106,12 @@ class RobotCollision:
         pin.updateGeometryPlacements(talos.model, data, gm, gd, talos.q_ref)
         self.rootMg_upper = np.array([gd.oMg[g].homogeneous for g in range(len(self.names))])
         self.self_pairs = self._self_pairs(talos)
-        self._joint_ids = [talos.model.getJointId(f"{prefix}_{k}_joint")
-                           for prefix in ("leg_left", "leg_right") for k in range(1, 7)]
+        self._leg_geoms = np.nonzero(self.leg_of >= 0)[0]
+        self._leg_side = self.leg_of[self._leg_geoms]
+        self._leg_frame = self.leg_link[self._leg_geoms] - 1
+        self._leg_hip = np.array([leg.hip_offset for leg in talos.legs])
+        self._leg_thigh = np.array([leg.thigh for leg in talos.legs])
+        self._leg_shin = np.array([leg.shin for leg in talos.legs])
 
     def _self_pairs(self, talos: TalosModel) -> np.ndarray:
         """Leg links 3-6 vs the other leg's links 3-6, and vs non-leg geometries not disabled in the SRDF."""
@@ -147,12 +151,8 @@ class RobotCollision:
         oMroot[:3, :3] = root_R
         oMroot[:3, 3] = root_p
         oMg = oMroot @ self.rootMg_upper
-        for side in (LEFT, RIGHT):
-            leg = talos.legs[side]
-            q = leg_q[side]
-            frames = _leg_joint_frames(leg.hip_offset, leg.thigh, leg.shin, q)  # [6, 4, 4] root frame
-            for g in talos.leg_geom_ids[side]:
-                oMg[g] = oMroot @ frames[self.leg_link[g] - 1] @ self.joint_geom[g]
+        frames = _legs_joint_frames(self._leg_hip, self._leg_thigh, self._leg_shin, leg_q)  # [2, 6, 4, 4]
+        oMg[self._leg_geoms] = oMroot @ frames[self._leg_side, self._leg_frame] @ self.joint_geom[self._leg_geoms]
         return oMg[:, :3, :3], oMg[:, :3, 3]
 
     def placements_pinocchio(self, talos: TalosModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -170,13 +170,14 @@ class RobotCollision:
         return np.stack([center - half, center + half], axis=1)
 
     def terrain_contacts(self, rot: np.ndarray, pos: np.ndarray, terrain: TerrainCollision,
-                         first_only: bool = True) -> list[tuple[int, int]]:
+                         first_only: bool = True, aabb: np.ndarray | None = None) -> list[tuple[int, int]]:
         """Geometry/terrain-box pairs in collision.
 
         Args:
             rot: [G, 3, 3], pos: [G, 3] geometry placements, world.
             terrain: the terrain's coal objects.
             first_only: stop at the first collision.
+            aabb: [G, 2, 3] `world_aabb(rot, pos)` if already computed.
 
         Returns:
             list of (geometry index, box index) in collision (empty: collision-free).
@@ -185,7 +186,7 @@ class RobotCollision:
 
         if len(terrain.aabb) == 0:
             return []
-        aabb = self.world_aabb(rot, pos)
+        aabb = self.world_aabb(rot, pos) if aabb is None else aabb
         overlap = np.all((aabb[:, None, 0] <= terrain.aabb[None, :, 1]) &
                          (aabb[:, None, 1] >= terrain.aabb[None, :, 0]), axis=2)
         hits = []
@@ -200,11 +201,12 @@ class RobotCollision:
                     break
         return hits
 
-    def self_contacts(self, rot: np.ndarray, pos: np.ndarray, first_only: bool = True) -> list[tuple[int, int]]:
+    def self_contacts(self, rot: np.ndarray, pos: np.ndarray, first_only: bool = True,
+                      aabb: np.ndarray | None = None) -> list[tuple[int, int]]:
         """Self-collision pairs (legs vs legs, legs vs upper body) in collision, same conventions."""
         import coal
 
-        aabb = self.world_aabb(rot, pos)
+        aabb = self.world_aabb(rot, pos) if aabb is None else aabb
         a, b = self.self_pairs[:, 0], self.self_pairs[:, 1]
         overlap = np.all((aabb[a, 0] <= aabb[b, 1]) & (aabb[a, 1] >= aabb[b, 0]), axis=1)
         hits = []
@@ -220,27 +222,33 @@ class RobotCollision:
         return hits
 
 
-def _leg_joint_frames(hip_offset: np.ndarray, thigh: float, shin: float, q: np.ndarray) -> np.ndarray:
-    """[6, 4, 4] root-frame placements of a leg's six joint frames (after each joint's rotation)."""
+def _legs_joint_frames(hip_offset: np.ndarray, thigh: np.ndarray, shin: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Root-frame placements of both legs' six joint frames (after each joint's rotation).
+
+    Args:
+        hip_offset: [2, 3] hip points, root frame; thigh, shin: [2] lengths, m.
+        q: [2, 6] leg joints, rad.
+
+    Returns:
+        [2, 6, 4, 4] placements, chain z, x, y, y, y, x of `ik.py` eq. (1)-(3).
+    """
     c, s = np.cos(q), np.sin(q)
-    rot = np.zeros((6, 3, 3))
+    steps = np.zeros((2, 6, 4, 4))
+    steps[:, :, 3, 3] = 1.0
     for k, axis in enumerate((2, 0, 1, 1, 1, 0)):
         i, j = [(1, 2), (2, 0), (0, 1)][axis]
-        rot[k, axis, axis] = 1.0
-        rot[k, i, i] = c[k]
-        rot[k, j, j] = c[k]
-        rot[k, i, j] = -s[k]
-        rot[k, j, i] = s[k]
-    offsets = (hip_offset, np.zeros(3), np.zeros(3), np.array([0.0, 0.0, -thigh]),
-               np.array([0.0, 0.0, -shin]), np.zeros(3))
-    frames = np.empty((6, 4, 4))
-    current = np.eye(4)
-    for k in range(6):
-        step = np.eye(4)
-        step[:3, :3] = rot[k]
-        step[:3, 3] = offsets[k]
-        current = current @ step
-        frames[k] = current
+        steps[:, k, axis, axis] = 1.0
+        steps[:, k, i, i] = c[:, k]
+        steps[:, k, j, j] = c[:, k]
+        steps[:, k, i, j] = -s[:, k]
+        steps[:, k, j, i] = s[:, k]
+    steps[:, 0, :3, 3] = hip_offset
+    steps[:, 3, 2, 3] = -thigh
+    steps[:, 4, 2, 3] = -shin
+    frames = np.empty((2, 6, 4, 4))
+    frames[:, 0] = steps[:, 0]
+    for k in range(1, 6):
+        frames[:, k] = frames[:, k - 1] @ steps[:, k]
     return frames
 
 

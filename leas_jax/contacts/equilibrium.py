@@ -141,6 +141,61 @@ class HppEquilibrium:
         return self.robustness(com)
 
 
+def convex_hull_2d(points: np.ndarray) -> np.ndarray:
+    """Counter-clockwise convex hull of a few 2-D points (Andrew's monotone chain).
+
+    Args:
+        points: [N, 2].
+
+    Returns:
+        [H, 2] hull vertices, counter-clockwise, no repeated point.
+    """
+    pts = sorted(set(map(tuple, np.asarray(points, dtype=np.float64).tolist())))
+    if len(pts) <= 2:
+        return np.array(pts).reshape(-1, 2)
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower, upper = [], []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def flat_support_margin(points: np.ndarray, normals: np.ndarray, com: np.ndarray) -> float:
+    """Distance of the CoM's vertical projection inside the support polygon, if all normals are vertical.
+
+    With every contact normal along +z, vertical contact forces alone balance gravity
+    iff the CoM projects inside the convex hull of the contact points, and each
+    hpp-centroidal-dynamics pyramid (4 edges symmetric about the normal) yields any
+    vertical force with equal generator coefficients; so a CoM strictly inside the
+    hull has robustness > 0. Used by the generator to skip the LP in clear cases.
+
+    Args:
+        points: [N, 3] contact points; normals: [N, 3] unit normals; com: [3], world.
+
+    Returns:
+        Signed distance (m, > 0 inside) of com[:2] to the hull boundary, or -inf if a
+        normal is not vertical or the hull is degenerate.
+    """
+    if len(points) < 3 or np.any(normals[:, 2] < 1.0 - 1e-12):
+        return -np.inf
+    hull = convex_hull_2d(points[:, :2])
+    if len(hull) < 3:
+        return -np.inf
+    edges = np.roll(hull, -1, axis=0) - hull
+    rel = com[:2] - hull
+    dist = (edges[:, 0] * rel[:, 1] - edges[:, 1] * rel[:, 0]) / np.hypot(edges[:, 0], edges[:, 1])
+    return float(dist.min())
+
+
 def friction_generators(normals: np.ndarray, mu: float = FRICTION,
                         count: int = GENERATORS_PER_CONTACT) -> np.ndarray:
     """Edges of the friction pyramids inscribed in the cones at each contact.

@@ -27,6 +27,8 @@ checks it against Pinocchio's forward kinematics.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from leas_jax.contacts.model import LegKinematics
@@ -82,6 +84,60 @@ def leg_ik(leg: LegKinematics, rootRsole, root_p_sole) -> tuple[np.ndarray, np.n
     q2 = np.arctan2(hip[:, 2, 1], c1 * hip[:, 1, 1] - s1 * hip[:, 0, 1])
     q3 = np.arctan2(-hip[:, 2, 0], hip[:, 2, 2])
     return np.stack([q1, q2, q3, q4, q5, q6], axis=1), reachable
+
+
+def leg_ik_single(leg: LegKinematics, rootRsole, root_p_sole) -> np.ndarray | None:
+    """`leg_ik` for one placement, in scalar arithmetic (the generator's hot path).
+
+    Host-only, not jittable. Same equations (1)-(7) as `leg_ik`, and additionally
+    checks the joint limits.
+
+    Args:
+        leg: the leg's constants.
+        rootRsole: [3, 3] sole orientation in the root frame.
+        root_p_sole: [3] sole position in the root frame, m.
+
+    Returns:
+        [6] leg joints, rad, or None when the ankle is out of reach or a joint limit is
+        violated.
+    """
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = np.asarray(rootRsole, dtype=np.float64).tolist()
+    px, py, pz = np.asarray(root_p_sole, dtype=np.float64).tolist()
+    hx, hy, hz = leg.hip_offset.tolist()
+    d, a, b = leg.sole_depth, leg.thigh, leg.shin
+    # (2) ankle, (3) r = R_s^T (h - ankle)
+    vx, vy, vz = hx - (px + d * r02), hy - (py + d * r12), hz - (pz + d * r22)
+    rx = r00 * vx + r10 * vy + r20 * vz
+    ry = r01 * vx + r11 * vy + r21 * vz
+    rz = r02 * vx + r12 * vy + r22 * vz
+    cos_knee = (rx * rx + ry * ry + rz * rz - a * a - b * b) / (2.0 * a * b)
+    if abs(cos_knee) > 1.0:
+        return None
+    q4 = math.acos(cos_knee)
+    flip = -1.0 if rz < 0.0 else 1.0
+    q6 = math.atan2(flip * ry, flip * rz)
+    w_z = flip * math.hypot(ry, rz)
+    q5 = math.atan2(-a * math.sin(q4), a * math.cos(q4) + b) - math.atan2(rx, w_z)
+    c6, s6 = math.cos(q6), math.sin(q6)
+    cp, sp = math.cos(q4 + q5), math.sin(q4 + q5)
+    # (7) R_h = R_s M, M = Rx(-q6) Ry(-(q4 + q5)); entries (0,1), (1,1), (2,0), (2,1), (2,2).
+    m00, m01, m02 = cp, 0.0, -sp
+    m10, m11, m12 = s6 * sp, c6, s6 * cp
+    m20, m21, m22 = c6 * sp, -s6, c6 * cp
+    h01 = r00 * m01 + r01 * m11 + r02 * m21
+    h11 = r10 * m01 + r11 * m11 + r12 * m21
+    h20 = r20 * m00 + r21 * m10 + r22 * m20
+    h21 = r20 * m01 + r21 * m11 + r22 * m21
+    h22 = r20 * m02 + r21 * m12 + r22 * m22
+    q1 = math.atan2(-h01, h11)
+    q2 = math.atan2(h21, math.cos(q1) * h11 - math.sin(q1) * h01)
+    q3 = math.atan2(-h20, h22)
+    q = (q1, q2, q3, q4, q5, q6)
+    lower, upper = leg.lower_list, leg.upper_list
+    for k in range(6):
+        if q[k] < lower[k] or q[k] > upper[k]:
+            return None
+    return np.array(q)
 
 
 def within_limits(leg: LegKinematics, q, margin: float = 0.0) -> np.ndarray:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,6 +112,26 @@ def quat_xyzw_from_matrix(rot) -> np.ndarray:
     return q.reshape(rot.shape[:-2] + (4,))
 
 
+def quat_xyzw_from_matrix_single(rot) -> np.ndarray:
+    """`quat_xyzw_from_matrix` for one [3, 3] matrix, in scalar arithmetic (hot path)."""
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.asarray(rot, dtype=np.float64).tolist()
+    tr = m00 + m11 + m22
+    if tr >= m00 and tr >= m11 and tr >= m22:
+        s = 2.0 * math.sqrt(1.0 + tr)
+        q = ((m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s)
+    elif m00 >= m11 and m00 >= m22:
+        s = 2.0 * math.sqrt(1.0 + m00 - m11 - m22)
+        q = (0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s)
+    elif m11 >= m22:
+        s = 2.0 * math.sqrt(1.0 + m11 - m00 - m22)
+        q = ((m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s)
+    else:
+        s = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
+        q = ((m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s)
+    norm = math.sqrt(sum(c * c for c in q)) * (-1.0 if q[3] < 0.0 else 1.0)
+    return np.array([c / norm for c in q])
+
+
 def matrix_from_quat_xyzw(quat) -> np.ndarray:
     """Rotation matrices of quaternions (x, y, z, w); normalises them first.
 
@@ -172,6 +193,16 @@ class LegKinematics:
     v_index: np.ndarray
     lower: np.ndarray
     upper: np.ndarray
+
+    @property
+    def lower_list(self) -> list[float]:
+        """`lower` as a list of floats (scalar hot paths)."""
+        return self.__dict__.setdefault("_lower_list", self.lower.tolist())
+
+    @property
+    def upper_list(self) -> list[float]:
+        """`upper` as a list of floats (scalar hot paths)."""
+        return self.__dict__.setdefault("_upper_list", self.upper.tolist())
 
 
 class TalosModel:
@@ -252,7 +283,7 @@ class TalosModel:
         """
         q = self.q_ref.copy()
         q[:3] = root_pos
-        q[3:7] = quat_xyzw_from_matrix(root_rot)
+        q[3:7] = quat_xyzw_from_matrix_single(root_rot)
         for side in (LEFT, RIGHT):
             q[self.legs[side].q_index] = leg_q[side]
         return q

@@ -1,0 +1,511 @@
+"""Contact generator: guide path -> quasi-static contact plan for Talos (RB-PRM style).
+
+Host-only (Pinocchio, coal, hpp-centroidal-dynamics, SciPy), not jittable.
+
+Algorithm (DESIGN §6, after the RB-PRM contact generator of Tonneau et al., T-RO
+2018, used by the paper through [7]):
+
+1. Contact planning runs on a subsampled guide: every `stride`-th pose plus the last.
+2. Initial stance: both soles at their half-sitting places under guide pose 0,
+   moved onto support surfaces.
+3. At each planning pose the generator first tries to keep both contacts: root on
+   the guide (yaw from the guide, height from the guide, lowered by at most
+   `max_root_offset_z` if a leg would be overstretched, shifted horizontally by at
+   most `max_root_offset_xy` toward the support centre if needed for equilibrium),
+   both legs by analytic IK, joint limits, terrain and leg collisions (coal),
+   double-support equilibrium (hpp-centroidal-dynamics LP, mu = 0.5).
+4. If keeping fails, a foot leaves its comfort region, or (once per pose) a foot
+   lags more than the step trigger behind its nominal place, the foot that lags
+   most steps: candidates are database samples (per-leg sole positions in the root
+   frame) near where the foot should be `lookahead` s ahead on the guide, projected
+   on nearby support surfaces, kept when the sole rectangle lies inside the face
+   polygon and nothing covers it, then ranked by distance to that target. The step
+   adds a single-support posture (foot in the air, NaN row; root shifted over the
+   stance sole; balanced on the stance foot alone) and a double-support posture with
+   the foot placed. The other foot is tried if the most lagging one cannot step. At
+   most `max_steps_per_pose` steps per planning pose.
+5. The generator stops at the first planning pose it cannot pass; `last_valid_index`
+   is the guide index of the last posture, `coverage` its arc-length fraction.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from leas_jax.contacts.collision import robot_collision, terrain_collision
+from leas_jax.contacts.database import DatabaseConfig, leg_database
+from leas_jax.contacts.equilibrium import HppEquilibrium, flat_support_margin, sole_corners
+from leas_jax.contacts.ik import leg_ik, leg_ik_single
+from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
+                                     load_talos, quat_xyzw_from_matrix_single, rotz)
+from leas_jax.contacts.plan import ContactPlan, coverage_of
+from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corners_world, sole_rotation,
+                                        surface_arrays, uncovered)
+from leas_jax.errors import UsageError
+
+
+@dataclass(frozen=True)
+class GeneratorConfig:
+    """Settings of the contact generator; defaults from DESIGN §6 and the Talos model."""
+
+    stride: int = 5  # guide poses per planning pose, DESIGN §6 ("every 5th pose by default")
+    lookahead: float = 0.7  # s, where a moving foot should land on the guide, DESIGN §6 (0.6-0.8 s)
+    mu: float = FRICTION  # friction coefficient, DESIGN §6 checks 1 and 4
+    step_trigger: float = 0.10  # m, horizontal lag of a foot behind its nominal place that makes it step
+    step_trigger_yaw: float = 0.20  # rad, yaw lag that makes a foot step (~ pi/9 rad/s x 0.5 s x 1.15)
+    max_foot_offset: float = 0.25  # m, comfort region: sole to its nominal place in the root frame
+    # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward
+    max_foot_yaw: float = 0.5
+    max_steps_per_pose: int = 2  # steps per planning pose (0.5 s at the default stride and timestep)
+    max_root_offset_xy: float = 0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
+    max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
+    min_knee: float = 0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
+    candidate_radius: float = 0.15  # m, database samples this close to a step target are candidates
+    candidate_slab: float = 0.03  # m, samples this close to a face plane are projected on it
+    candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
+    max_candidates: int = 12  # candidates tried per step (in rank order)
+    edge_margin: float = 0.01  # m, sole rectangle kept this far inside the face polygon
+    cover_tol: float = 0.005  # m, a sole is covered if the terrain rises more than this above it (DESIGN §6: 5 mm)
+    feet_gap: float = 0.02  # m, minimal gap between the two sole rectangles
+    swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
+    min_robustness: float = 1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
+    # m, on horizontal faces a CoM this far inside the support polygon is in equilibrium
+    # without solving the LP (equilibrium.flat_support_margin; robustness > 4 there)
+    flat_com_margin: float = 0.015
+    database: DatabaseConfig = field(default_factory=DatabaseConfig)
+
+
+@dataclass
+class _Posture:
+    """One key posture: configuration, feet (NaN row in the air), guide index."""
+
+    q: np.ndarray  # [39]
+    feet: np.ndarray  # [2, 7]
+    guide_index: int
+
+
+def _placement_row(pos, rot) -> np.ndarray:
+    """[7] xyz + quaternion xyzw of a placement (pos [3], rot [3, 3])."""
+    return np.concatenate([pos, quat_xyzw_from_matrix_single(rot)])
+
+
+class ContactGenerator:
+    """Contact generator for one terrain; reuses its collision objects across guides.
+
+    Host-only, not jittable; holds Pinocchio/coal/LP solver state, so use one per
+    process or thread.
+
+    Args:
+        terrain: a leas_jax.terrain.Terrain.
+        config: generator settings.
+    """
+
+    def __init__(self, terrain, config: GeneratorConfig = GeneratorConfig()):
+        self.terrain = terrain
+        self.config = config
+        self.talos = load_talos()
+        self.robot = robot_collision(self.talos)
+        self.terrain_objects = terrain_collision(terrain)
+        self.surfaces = surface_arrays(terrain, config.mu)
+        self.equilibrium = HppEquilibrium(self.talos.mass, config.mu)
+        self.databases = (leg_database(LEFT, config.database), leg_database(RIGHT, config.database))
+        legs = self.talos.legs
+        self._reach = [math.sqrt(leg.thigh ** 2 + leg.shin ** 2 + 2 * leg.thigh * leg.shin * math.cos(config.min_knee))
+                       for leg in legs]
+        self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
+        self.stats = {"postures_tried": 0, "candidates": 0}
+
+    # ------------------------------------------------------------------ postures
+
+    def _legs_ik(self, root_R, root_p, contacts) -> np.ndarray | None:
+        """Leg joints [2, 6] placing each contact sole, or None (unreachable / joint limits).
+
+        contacts: list of (side, pos [3], rot [3, 3]) world sole placements for both legs.
+        """
+        leg_q = np.empty((2, 6))
+        for side, pos, rot in contacts:
+            q = leg_ik_single(self.talos.legs[side], root_R.T @ rot, root_R.T @ (pos - root_p))
+            if q is None:
+                return None
+            leg_q[side] = q
+        return leg_q
+
+    def _root_height(self, guide_pose, root_xy, root_R, contacts) -> float | None:
+        """Root z: the guide's, lowered (<= max_root_offset_z) so that no contact leg is overstretched."""
+        z = guide_pose[2]
+        for side, pos, rot in contacts:
+            leg = self.talos.legs[side]
+            ankle = pos + leg.sole_depth * rot[:, 2]
+            hip_xy = root_xy + (root_R @ leg.hip_offset)[:2]
+            horizontal = float(np.hypot(*(hip_xy - ankle[:2])))
+            reach = self._reach[side]
+            if horizontal >= reach:
+                return None
+            top = ankle[2] + math.sqrt(reach * reach - horizontal * horizontal) - leg.hip_offset[2]
+            z = min(z, top)
+        if guide_pose[2] - z > self.config.max_root_offset_z:
+            return None
+        return z
+
+    def _posture(self, guide_pose, guide_index: int, contacts, air=None, com_target=None) -> _Posture | None:
+        """Check and build a posture at a guide pose.
+
+        Args:
+            guide_pose: [4] (x, y, z, yaw) guide root pose, world.
+            guide_index: its guide index.
+            contacts: list of (side, pos, rot) soles in contact, world.
+            air: None, or (side, list of (pos, rot) world placements to try for the foot
+                in the air, in order).
+            com_target: [2] where the root shift should bring the CoM (x, y), or None to
+                try the guide root first and shift toward the support centre only if needed.
+
+        Returns:
+            the posture, or None when no root offset gives a valid posture.
+        """
+        cfg = self.config
+        self.stats["postures_tried"] += 1
+        root_R = rotz(guide_pose[3])
+        guide_xy = np.asarray(guide_pose[:2], dtype=np.float64)
+        support_centre = np.mean([pos[:2] for _, pos, _ in contacts], axis=0)
+        target = support_centre if com_target is None else np.asarray(com_target)
+        offsets = [None] if com_target is not None else [np.zeros(2), None]
+        for offset in offsets:
+            built = self._build(guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air)
+            if built is not None:
+                return built
+        return None
+
+    def _build(self, guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air):
+        """One root offset (None: shift the CoM onto `target`); all checks. Returns a posture or None."""
+        cfg = self.config
+        talos = self.talos
+        iterations = 1 if offset is not None else 3
+        shift = np.zeros(2) if offset is None else offset
+        for it in range(iterations):
+            norm = float(np.hypot(*shift))
+            if norm > cfg.max_root_offset_xy:
+                shift = shift * (cfg.max_root_offset_xy / norm)
+            root_xy = guide_xy + shift
+            z = self._root_height(guide_pose, root_xy, root_R, contacts)
+            if z is None:
+                return None
+            root_p = np.array([root_xy[0], root_xy[1], z])
+            leg_q = self._legs_ik(root_R, root_p, contacts)
+            if leg_q is None:
+                return None
+            feet = np.full((2, 7), np.nan)
+            for side, pos, rot in contacts:
+                feet[side] = _placement_row(pos, rot)
+            if air is not None:
+                side, options = air
+                for pos, rot in options:
+                    solved = self._legs_ik(root_R, root_p, [(side, pos, rot)])
+                    if solved is not None:
+                        leg_q[side] = solved[side]
+                        break
+                else:
+                    return None
+            q = talos.configuration(root_p, root_R, leg_q)
+            com = talos.com(q)
+            if offset is None and it + 1 < iterations:
+                error = target - com[:2]
+                if float(np.hypot(*error)) < 0.005:
+                    iterations = it + 1  # converged: check this one
+                else:
+                    shift = shift + error
+                    continue
+            points, normals = sole_corners(feet)
+            if flat_support_margin(points, normals, com) < cfg.flat_com_margin:
+                self.equilibrium.set_contacts(points, normals)
+                if self.equilibrium.robustness(com) < cfg.min_robustness:
+                    return None
+            rot, pos = self.robot.placements_fast(talos, root_R, root_p, leg_q)
+            aabb = self.robot.world_aabb(rot, pos)
+            if self.robot.terrain_contacts(rot, pos, self.terrain_objects, aabb=aabb):
+                return None
+            if self.robot.self_contacts(rot, pos, aabb=aabb):
+                return None
+            return _Posture(q=q, feet=feet, guide_index=guide_index)
+        return None
+
+    # ------------------------------------------------------------------ candidates
+
+    def _nominal_placement(self, guide_pose, side: int) -> tuple[np.ndarray, float]:
+        """World (x, y, z) of a sole at its half-sitting place under a guide pose, and its yaw."""
+        root_R = rotz(guide_pose[3])
+        pos = np.asarray(guide_pose[:3], dtype=np.float64) + root_R @ self._nominal[side]
+        return pos, float(guide_pose[3])
+
+    def candidates(self, side: int, guide_pose, target_pos, target_yaw: float, avoid=None):
+        """Ranked sole placements for one foot near a target (vectorised).
+
+        Host-only, not jittable.
+
+        Args:
+            side: 0 left, 1 right.
+            guide_pose: [4] root pose the leg reaches from, world.
+            target_pos: [3] where the sole should be, world (z: guess, the faces decide).
+            target_yaw: heading of the sole, rad.
+            avoid: None or (pos [3], rot [3, 3]) of the other sole, not to be overlapped.
+
+        Returns:
+            (pos [N, 3], rot [N, 3, 3]) world sole placements sorted by horizontal
+            distance to the target: the target's vertical projection on each nearby
+            face, and the database samples within `candidate_radius` of it and
+            `candidate_slab` of the face, projected on it; at most 4 x max_candidates
+            before the polygon, cover, overlap and reach filters.
+        """
+        cfg = self.config
+        surfaces = self.surfaces
+        db = self.databases[side]
+        root_R = rotz(guide_pose[3])
+        root_p = np.asarray(guide_pose[:3], dtype=np.float64)
+        target_pos = np.asarray(target_pos, dtype=np.float64)
+        empty = np.zeros((0, 3)), np.zeros((0, 3, 3))
+        reach = cfg.candidate_radius + 0.5 * math.hypot(SOLE_LENGTH, SOLE_WIDTH)
+        near = np.nonzero(np.all((surfaces.bbox[:, 0, :2] - reach <= target_pos[:2]) &
+                                 (surfaces.bbox[:, 1, :2] + reach >= target_pos[:2]), axis=1))[0]
+        points, owner = [], []
+        for s in near:
+            normal = surfaces.normals[s]
+            # Vertical projection of the target on the face plane: itself a candidate.
+            height = (surfaces.offsets[s] - normal[:2] @ target_pos[:2]) / normal[2]
+            on_plane = np.array([target_pos[0], target_pos[1], height])
+            idx = db.near(root_R.T @ (on_plane - root_p), cfg.candidate_radius)
+            world = root_p + db.positions[idx] @ root_R.T
+            world = world[np.abs(world @ normal - surfaces.offsets[s]) <= cfg.candidate_slab]
+            # Database samples near the plane, projected on it along the normal.
+            world = world - np.outer(world @ normal - surfaces.offsets[s], normal)
+            points.append(on_plane[None])
+            points.append(world)
+            owner.append(np.full(len(world) + 1, s))
+        if not points:
+            return empty
+        pos = np.concatenate(points)
+        owner = np.concatenate(owner)
+        order = np.argsort(np.hypot(pos[:, 0] - target_pos[0], pos[:, 1] - target_pos[1]), kind="stable")
+        pos, owner = pos[order], owner[order]
+        # One candidate per grid cell (database samples cluster), the closest to the target.
+        cells = np.round(pos / cfg.candidate_grid).astype(np.int64)
+        _, first = np.unique(cells, axis=0, return_index=True)
+        keep = np.sort(first)[:4 * cfg.max_candidates]
+        pos, owner = pos[keep], owner[keep]
+        rot = sole_rotation(surfaces.normals[owner], target_yaw)
+        corners = sole_corners_world(pos, rot)
+        ok = np.zeros(len(pos), dtype=bool)
+        for s in np.unique(owner):
+            mine = owner == s
+            ok[mine] = np.all(inside_polygon(surfaces.surfaces[s], corners[mine], cfg.edge_margin), axis=1)
+        if avoid is not None:
+            ok[ok] = ~self._overlaps(pos[ok], rot[ok], *avoid)
+        probe = np.concatenate([corners[ok], pos[ok][:, None, :]], axis=1).reshape(-1, 3)
+        ok[ok] = np.all(uncovered(self.terrain, probe, cfg.cover_tol).reshape(-1, 5), axis=1)
+        pos, rot = pos[ok], rot[ok]
+        # Reachable within the joint limits from the guide root or the lowest allowed root.
+        leg = self.talos.legs[side]
+        reachable = np.zeros(len(pos), dtype=bool)
+        local_rot = np.einsum("ji,njk->nik", root_R, rot)
+        for dz in (0.0, cfg.max_root_offset_z):
+            q, within = leg_ik(leg, local_rot, (pos - (root_p - np.array([0.0, 0.0, dz]))) @ root_R)
+            reachable |= within & np.all((q >= leg.lower) & (q <= leg.upper), axis=1)
+        self.stats["candidates"] += int(reachable.sum())
+        return pos[reachable], rot[reachable]
+
+    def _overlaps(self, pos, rot, other_pos, other_rot) -> np.ndarray:
+        """[N] whether sole rectangles (pos [N,3], rot [N,3,3]) come within feet_gap of another sole.
+
+        Separating-axis test of the rectangles projected on the horizontal plane, grown
+        by feet_gap / 2 each.
+        """
+        half = np.array([SOLE_LENGTH / 2, SOLE_WIDTH / 2]) + self.config.feet_gap / 2
+        axes_a = rot[:, :2, :2]  # columns: sole x, y projected
+        axes_b = np.broadcast_to(other_rot[:2, :2], axes_a.shape)
+        delta = other_pos[:2] - pos[:, :2]
+        separated = np.zeros(len(pos), dtype=bool)
+        for axes in (axes_a, axes_b):
+            for k in range(2):
+                axis = axes[:, :, k]
+                axis = axis / np.linalg.norm(axis, axis=1, keepdims=True)
+                ra = np.abs(np.einsum("ni,nij->nj", axis, axes_a)) @ half
+                rb = np.abs(np.einsum("ni,nij->nj", axis, axes_b)) @ half
+                separated |= np.abs(np.einsum("ni,ni->n", axis, delta)) > ra + rb
+        return ~separated
+
+    # ------------------------------------------------------------------ walking
+
+    def _foot_lag(self, guide_pose, side, pos, rot) -> tuple[float, float]:
+        """(horizontal distance, |yaw difference|) of a sole to its nominal place under a guide pose."""
+        root_R = rotz(guide_pose[3])
+        local = root_R.T @ (pos - np.asarray(guide_pose[:3]))
+        dist = float(np.hypot(*(local[:2] - self._nominal[side][:2])))
+        yaw = math.atan2(rot[1, 0], rot[0, 0]) - guide_pose[3]
+        yaw = abs((yaw + math.pi) % (2 * math.pi) - math.pi)
+        return dist, yaw
+
+    def _comfortable(self, guide_pose, contacts) -> bool:
+        cfg = self.config
+        for side, pos, rot in contacts:
+            dist, yaw = self._foot_lag(guide_pose, side, pos, rot)
+            if dist > cfg.max_foot_offset or yaw > cfg.max_foot_yaw:
+                return False
+        return True
+
+    def _lag_score(self, guide_pose, side, pos, rot) -> float:
+        dist, yaw = self._foot_lag(guide_pose, side, pos, rot)
+        return max(dist / self.config.step_trigger, yaw / self.config.step_trigger_yaw)
+
+    def _step(self, guide, timestep, index: int, feet, side: int) -> list[_Posture] | None:
+        """Move foot `side` at planning index `index`: [single-support, double-support] postures or None."""
+        cfg = self.config
+        pose = guide[index]
+        other = 1 - side
+        stance = (other, feet[other][0], feet[other][1])
+        old_pos, old_rot = feet[side]
+        lifted = [(old_pos + np.array([0.0, 0.0, cfg.swing_lift]), old_rot)]
+        nominal_pos, _ = self._nominal_placement(pose, side)
+        lifted.append((nominal_pos + np.array([0.0, 0.0, cfg.swing_lift]), rotz(pose[3])))
+        single = self._posture(pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2])
+        if single is None:
+            return None
+        ahead = guide[min(index + int(round(cfg.lookahead / timestep)), len(guide) - 1)]
+        target_pos, target_yaw = self._nominal_placement(ahead, side)
+        pos, rot = self.candidates(side, pose, target_pos, target_yaw, avoid=feet[other])
+        for k in range(min(len(pos), cfg.max_candidates)):
+            contacts = [stance, (side, pos[k], rot[k])]
+            if not self._comfortable(pose, contacts[1:]):
+                continue
+            double = self._posture(pose, index, contacts)
+            if double is not None:
+                feet[side] = (pos[k], rot[k])
+                return [single, double]
+        return None
+
+    def _initial(self, guide) -> tuple[list, _Posture] | None:
+        """Initial stance at guide pose 0: feet at their nominal places moved onto faces."""
+        pose = guide[0]
+        feet = [None, None]
+        for side in (LEFT, RIGHT):
+            target, yaw = self._nominal_placement(pose, side)
+            avoid = feet[1 - side] if feet[1 - side] is not None else None
+            pos, rot = self.candidates(side, pose, target, yaw, avoid=avoid)
+            if len(pos) == 0:
+                return None
+            feet[side] = (pos[0], rot[0])
+        contacts = [(side, feet[side][0], feet[side][1]) for side in (LEFT, RIGHT)]
+        posture = self._posture(pose, 0, contacts)
+        if posture is None:
+            return None
+        return feet, posture
+
+    def plan(self, guide, timestep: float) -> ContactPlan:
+        """Contact plan along a guide path (see the module docstring).
+
+        Host-only, not jittable.
+
+        Args:
+            guide: [T, 4] root poses (x, y, z, yaw), world frame, z = base_link height.
+            timestep: s between guide poses.
+
+        Returns:
+            ContactPlan with the postures up to the first planning pose that fails.
+        """
+        guide = np.asarray(guide, dtype=np.float64)
+        if guide.ndim != 2 or guide.shape[1] != 4 or len(guide) == 0:
+            raise UsageError(f"guide must have shape [T, 4] with T >= 1, got {guide.shape}")
+        if not np.all(np.isfinite(guide)):
+            raise UsageError("guide contains NaN or inf")
+        if not (timestep > 0 and math.isfinite(timestep)):
+            raise UsageError(f"timestep must be a positive number of seconds, got {timestep!r}")
+        cfg = self.config
+        postures: list[_Posture] = []
+        last_valid = -1
+        start = self._initial(guide)
+        if start is not None:
+            feet, first = start
+            postures.append(first)
+            last_valid = 0
+            indices = list(range(cfg.stride, len(guide), cfg.stride))
+            if len(guide) > 1 and (not indices or indices[-1] != len(guide) - 1):
+                indices.append(len(guide) - 1)
+            for index in indices:
+                added = self._advance(guide, timestep, index, feet)
+                if added is None:
+                    break
+                postures.extend(added)
+                last_valid = index
+        return self._make_plan(guide, timestep, postures, last_valid)
+
+    def _advance(self, guide, timestep, index: int, feet) -> list[_Posture] | None:
+        """Postures that bring the robot to planning pose `index` (mutates `feet`), or None."""
+        cfg = self.config
+        pose = guide[index]
+
+        def stance():
+            return [(side, feet[side][0], feet[side][1]) for side in (LEFT, RIGHT)]
+
+        def scores():
+            return [self._lag_score(pose, side, *feet[side]) for side in (LEFT, RIGHT)]
+
+        keep = self._posture(pose, index, stance()) if self._comfortable(pose, stance()) else None
+        if keep is not None and max(scores()) <= 1.0:
+            return [keep]
+        added: list[_Posture] = []
+        for _ in range(cfg.max_steps_per_pose):
+            lag = scores()
+            for side in sorted((LEFT, RIGHT), key=lambda s: -lag[s]):
+                stepped = self._step(guide, timestep, index, feet, side)
+                if stepped is not None:
+                    added.extend(stepped)
+                    break
+            else:
+                break
+            if self._comfortable(pose, stance()):
+                return added  # its last double-support posture stands at this pose
+        if not added and keep is not None:
+            return [keep]  # no step possible but the stance still holds: step later
+        return None
+
+    def _make_plan(self, guide, timestep, postures, last_valid) -> ContactPlan:
+        if postures:
+            q = np.stack([p.q for p in postures])
+            feet = np.stack([p.feet for p in postures])
+            guide_index = np.array([p.guide_index for p in postures], dtype=np.int64)
+        else:
+            q, feet, guide_index = np.zeros((0, 39)), np.zeros((0, 2, 7)), np.zeros(0, dtype=np.int64)
+        return ContactPlan(q=q, feet=feet, guide_index=guide_index, last_valid_index=last_valid,
+                           coverage=coverage_of(guide, last_valid), terrain=self.terrain.text, guide=guide,
+                           timestep=timestep)
+
+
+_GENERATORS: dict = {}
+
+
+def plan_contacts(terrain, guide, timestep: float, config: GeneratorConfig = GeneratorConfig()) -> ContactPlan:
+    """Contact plan of a guide path on a terrain (DESIGN §6).
+
+    Host-only, not jittable. Reuses one ContactGenerator per (terrain object, config)
+    in the process (the latest one only), so repeated calls on one terrain share its
+    collision objects.
+
+    Args:
+        terrain: a leas_jax.terrain.Terrain.
+        guide: [T, 4] root poses (x, y, z, yaw), world frame, z = base_link height
+            (NOMINAL_ROOT_HEIGHT above the ground for standing on flat ground).
+        timestep: s between guide poses.
+        config: generator settings.
+
+    Returns:
+        ContactPlan.
+    """
+    key = (id(terrain), config)
+    generator = _GENERATORS.get("latest")
+    if generator is None or generator[0] != key or generator[1].terrain is not terrain:
+        generator = (key, ContactGenerator(terrain, config))
+        _GENERATORS["latest"] = generator
+    return generator[1].plan(guide, timestep)
+
+
+__all__ = ["ContactGenerator", "GeneratorConfig", "NOMINAL_ROOT_HEIGHT", "plan_contacts"]

@@ -1,0 +1,162 @@
+"""Support surfaces as arrays, and sole-rectangle placement tests on them.
+
+Host-only (NumPy), not jittable. Wraps `Terrain.support_surfaces(mu)` (box faces whose
+normal is within the friction cone) with what the generator and the verifier need:
+plane equations, polygon edges, bounding boxes, the sole orientation on a face and
+the "sole rectangle inside the face polygon" test of DESIGN §6 check 1.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from leas_jax.contacts.model import SOLE_LENGTH, SOLE_WIDTH
+
+# Sole rectangle corners in the sole frame (x forward, y left), counter-clockwise.
+SOLE_CORNERS = np.array([[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0]
+                         for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
+
+
+@dataclass(frozen=True)
+class SurfaceArrays:
+    """Support surfaces of a terrain, as arrays.
+
+    Attributes:
+        surfaces: the terrain's SupportSurface list.
+        normals: [S, 3] unit outward normals.
+        offsets: [S] plane offsets n . v0 (points x on the plane have n . x = offset).
+        bbox: [S, 2, 3] axis-aligned bounds of each polygon, world.
+    """
+
+    surfaces: tuple
+    normals: np.ndarray
+    offsets: np.ndarray
+    bbox: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.surfaces)
+
+
+_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def surface_arrays(terrain, mu: float) -> SurfaceArrays:
+    """SurfaceArrays of `terrain.support_surfaces(mu)`, built once per terrain object and mu."""
+    per_terrain = _CACHE.setdefault(terrain, {})
+    if mu not in per_terrain:
+        surfaces = tuple(terrain.support_surfaces(mu=mu))
+        normals = np.array([s.normal for s in surfaces]).reshape(-1, 3)
+        offsets = np.array([float(s.normal @ s.vertices[0]) for s in surfaces])
+        bbox = np.array([[s.vertices.min(axis=0), s.vertices.max(axis=0)] for s in surfaces]).reshape(-1, 2, 3)
+        per_terrain[mu] = SurfaceArrays(surfaces, normals, offsets, bbox)
+    return per_terrain[mu]
+
+
+def sole_rotation(normal, yaw) -> np.ndarray:
+    """Sole orientations lying flat on faces with a given heading.
+
+    z = the face normal; x = the heading (cos yaw, sin yaw, 0) projected on the face;
+    y = z x x.
+
+    Args:
+        normal: [N, 3] unit face normals (not vertical faces).
+        yaw: [N] headings, rad.
+
+    Returns:
+        [N, 3, 3] world_R_sole.
+    """
+    normal = np.asarray(normal, dtype=np.float64).reshape(-1, 3)
+    yaw = np.broadcast_to(np.asarray(yaw, dtype=np.float64), (len(normal),))
+    heading = np.stack([np.cos(yaw), np.sin(yaw), np.zeros_like(yaw)], axis=1)
+    x = heading - np.einsum("ni,ni->n", heading, normal)[:, None] * normal
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    y = np.cross(normal, x)
+    return np.stack([x, y, normal], axis=2)
+
+
+def sole_corners_world(pos, rot) -> np.ndarray:
+    """[N, 4, 3] sole rectangle corners of soles at pos [N, 3], rot [N, 3, 3], world."""
+    return np.asarray(pos)[:, None, :] + np.einsum("nij,cj->nci", rot, SOLE_CORNERS)
+
+
+def inside_polygon(surface, points, margin: float = 0.0) -> np.ndarray:
+    """Whether points on a face's plane lie inside its polygon, `margin` m from the edges.
+
+    The polygon is counter-clockwise seen from the normal's tip, so a point p is
+    inside iff ((v_{k+1} - v_k) x (p - v_k)) . n >= 0 for every edge k; dividing by the
+    edge length gives the signed distance to the edge line.
+
+    Args:
+        surface: a SupportSurface.
+        points: [..., 3] world points (projected on the plane along the normal first).
+        margin: required distance from every edge, m (negative: tolerance outside).
+
+    Returns:
+        [...] bool.
+    """
+    verts = surface.vertices
+    normal = surface.normal
+    pts = np.asarray(points, dtype=np.float64)
+    pts = pts - ((pts - verts[0]) @ normal)[..., None] * normal
+    ok = np.ones(pts.shape[:-1], dtype=bool)
+    for k in range(len(verts)):
+        edge = verts[(k + 1) % len(verts)] - verts[k]
+        inward = np.cross(normal, edge)
+        inward /= np.linalg.norm(inward)
+        ok &= (pts - verts[k]) @ inward >= margin
+    return ok
+
+
+def uncovered(terrain, points, tol: float) -> np.ndarray:
+    """Whether nothing of the terrain rises more than `tol` above points (vertical ray cast).
+
+    Args:
+        terrain: the Terrain.
+        points: [N, 3] world points (sole corners and centres on a face).
+        tol: allowed height difference, m.
+
+    Returns:
+        [N] bool.
+    """
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return terrain.height_at(points[:, :2]) <= points[:, 2] + tol
+
+
+def find_support(terrain, surfaces: SurfaceArrays, pos, rot, dist_tol: float, angle_tol: float,
+                 edge_tol: float) -> tuple[int, str]:
+    """The support surface a sole rests on, DESIGN §6 check 1.
+
+    Args:
+        terrain: the Terrain (unused by the test itself; kept for messages).
+        surfaces: its support surfaces.
+        pos: [3] sole position, world; rot: [3, 3] world_R_sole.
+        dist_tol: max distance of the sole centre to the face plane, m (5 mm).
+        angle_tol: max angle between the sole z axis and the face normal, rad (3 deg).
+        edge_tol: how far the sole corners may stick out of the polygon, m.
+
+    Returns:
+        (surface index, "") when found, else (-1, reason naming the closest face).
+    """
+    del terrain
+    pos = np.asarray(pos, dtype=np.float64)
+    if len(surfaces) == 0:
+        return -1, "the terrain has no support surface"
+    corners = sole_corners_world(pos[None], np.asarray(rot)[None])[0]
+    dist = surfaces.normals @ pos - surfaces.offsets
+    cos_angle = np.clip(surfaces.normals @ rot[:, 2], -1.0, 1.0)
+    angle = np.arccos(cos_angle)
+    best_reason, best_score = "", np.inf
+    for s in np.argsort(np.abs(dist)):
+        surface = surfaces.surfaces[s]
+        inside = inside_polygon(surface, corners, -edge_tol)
+        if abs(dist[s]) <= dist_tol and angle[s] <= angle_tol and inside.all():
+            return int(s), ""
+        score = abs(dist[s]) + angle[s] + (0 if inside.all() else 1.0)
+        if score < best_score:
+            best_score = score
+            best_reason = (f"closest face (box {surface.box_index}): plane distance {1000 * dist[s]:.1f} mm, "
+                           f"tilt {np.degrees(angle[s]):.2f} deg, {int((~inside).sum())} sole corners outside")
+    return -1, "sole not on a support surface; " + best_reason

@@ -1,0 +1,203 @@
+"""Verifier: re-run the five checks of DESIGN §6 on a contact plan, from its arrays alone.
+
+Host-only (Pinocchio, coal, hpp-centroidal-dynamics), not jittable. Independent of
+the generator's code paths where it matters: forward kinematics and geometry
+placements come from Pinocchio (the generator uses its own NumPy kinematics), the
+support surfaces and collision objects are rebuilt from the terrain text stored in
+the plan (`leas_jax.terrain.loads_terrain`), and equilibrium is hpp-centroidal-
+dynamics' LP on the CoM Pinocchio computes for each saved configuration.
+
+Checks (numbering of DESIGN §6; 0 is the plan's own consistency):
+    0. arrays: finite q, feet rows all-finite or all-NaN, guide indices in range and
+       non-decreasing, last_valid_index / coverage consistent with the guide;
+    1. each foot in contact lies flat on a support surface (sole rectangle 0.20 x 0.13 m
+       inside a face whose normal is within the friction cone), within 5 mm and 3 deg;
+    2. Pinocchio forward kinematics of q puts the sole frames at `feet` within 1 mm;
+    3. joint limits hold; no collision with the terrain (coal), nor between the legs;
+    4. static equilibrium with robustness >= 0 (hpp-centroidal-dynamics LP over the
+       sole corners of the feet in contact, mu = 0.5);
+    5. consecutive postures differ by at most one foot, and a foot changes placement
+       only through a posture where it is in the air.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from leas_jax.contacts.model import FRICTION, matrix_from_quat_xyzw
+
+CONTACT_DIST_TOL = 0.005  # m, DESIGN §6 check 1
+CONTACT_ANGLE_TOL = math.radians(3.0)  # rad, DESIGN §6 check 1
+CONTACT_EDGE_TOL = 0.005  # m, how far a sole corner may stick out of its face (same 5 mm tolerance)
+FK_TOL = 0.001  # m, DESIGN §6 check 2
+FK_ANGLE_TOL = math.radians(1.0)  # rad, sole orientation from FK vs `feet` (the 1 mm of check 2 over a 0.1 m half-sole is ~0.6 deg)
+JOINT_TOL = 1e-6  # rad, rounding allowance on the joint limits
+SAME_PLACEMENT_TOL = 1e-6  # m (and unit-free on rotation matrices): a foot that stays in place
+
+
+@dataclass
+class VerificationReport:
+    """Result of `verify`.
+
+    Attributes:
+        failures: list of (posture index, check number 0-5, message); posture index -1
+            for plan-level problems.
+        postures: number of postures checked.
+    """
+
+    failures: list = field(default_factory=list)
+    postures: int = 0
+
+    @property
+    def ok(self) -> bool:
+        """True when every posture passes every check."""
+        return not self.failures
+
+    def checks_failed(self) -> set[int]:
+        """The set of check numbers with at least one failure."""
+        return {check for _, check, _ in self.failures}
+
+    def __str__(self) -> str:
+        if self.ok:
+            return f"OK: {self.postures} postures pass all checks"
+        lines = [f"posture {k}: check {c}: {m}" for k, c, m in self.failures]
+        return "\n".join(lines + [f"FAILED: {len(self.failures)} failed checks"])
+
+
+def verify(plan, terrain=None) -> VerificationReport:
+    """Re-run the DESIGN §6 checks on every posture of a plan.
+
+    Host-only, not jittable.
+
+    Args:
+        plan: a ContactPlan (e.g. `ContactPlan.load(path)`).
+        terrain: the Terrain to check against; None (default) rebuilds it from
+            `plan.terrain` (the terrain file text saved with the plan).
+
+    Returns:
+        VerificationReport listing each (posture, check, message) that fails.
+    """
+    from leas_jax.contacts.collision import robot_collision, terrain_collision
+    from leas_jax.contacts.equilibrium import HppEquilibrium, sole_corners
+    from leas_jax.contacts.model import load_talos
+    from leas_jax.contacts.plan import coverage_of
+    from leas_jax.contacts.surfaces import find_support, surface_arrays
+    from leas_jax.terrain import loads_terrain
+
+    if terrain is None:
+        terrain = loads_terrain(plan.terrain, source="<plan terrain>")
+    talos = load_talos()
+    robot = robot_collision(talos)
+    objects = terrain_collision(terrain)
+    surfaces = surface_arrays(terrain, FRICTION)
+    equilibrium = HppEquilibrium(talos.mass, FRICTION)
+
+    q_all = np.asarray(plan.q, dtype=np.float64)
+    feet_all = np.asarray(plan.feet, dtype=np.float64)
+    guide = np.asarray(plan.guide, dtype=np.float64)
+    guide_index = np.asarray(plan.guide_index)
+    report = VerificationReport(postures=len(q_all))
+    fail = report.failures
+
+    # 0. plan consistency
+    if len(q_all) and (np.any(guide_index < 0) or np.any(guide_index >= len(guide))):
+        fail.append((-1, 0, f"guide_index outside [0, {len(guide) - 1}]"))
+    if np.any(np.diff(guide_index) < 0):
+        fail.append((-1, 0, "guide_index decreases"))
+    last = int(plan.last_valid_index)
+    expected_last = int(guide_index[-1]) if len(guide_index) else -1
+    if last != expected_last:
+        fail.append((-1, 0, f"last_valid_index {last} is not the last posture's guide index {expected_last}"))
+    if abs(float(plan.coverage) - coverage_of(guide, last)) > 1e-6:
+        fail.append((-1, 0, f"coverage {float(plan.coverage):.6f} is not the arc-length fraction "
+                            f"{coverage_of(guide, last):.6f} of guide index {last}"))
+
+    contact = np.zeros(feet_all.shape[:2], dtype=bool)
+    for k in range(len(q_all)):
+        q = q_all[k]
+        if not np.all(np.isfinite(q)):
+            fail.append((k, 0, "q has NaN or inf"))
+            continue
+        feet = feet_all[k]
+        for side in (0, 1):
+            finite = np.isfinite(feet[side])
+            if finite.any() and not finite.all():
+                fail.append((k, 0, f"{_foot(side)} row is partly NaN"))
+            contact[k, side] = finite.all()
+        rotations = [matrix_from_quat_xyzw(feet[side, 3:]) if contact[k, side] else None for side in (0, 1)]
+
+        # 1. flat on a support surface
+        for side in (0, 1):
+            if contact[k, side]:
+                index, reason = find_support(terrain, surfaces, feet[side, :3], rotations[side],
+                                             CONTACT_DIST_TOL, CONTACT_ANGLE_TOL, CONTACT_EDGE_TOL)
+                if index < 0:
+                    fail.append((k, 1, f"{_foot(side)}: {reason}"))
+
+        # 2. forward kinematics
+        soles = talos.sole_placements(q)
+        for side in (0, 1):
+            if contact[k, side]:
+                err = float(np.linalg.norm(soles[side, :3] - feet[side, :3]))
+                rot_fk = matrix_from_quat_xyzw(soles[side, 3:])
+                angle = _angle_between(rot_fk, rotations[side])
+                if err > FK_TOL or angle > FK_ANGLE_TOL:
+                    fail.append((k, 2, f"{_foot(side)}: FK sole is {1000 * err:.2f} mm and "
+                                       f"{math.degrees(angle):.2f} deg from feet"))
+
+        # 3. joint limits, collisions
+        for name, value, lo, hi in talos.joint_limit_violations(q, JOINT_TOL):
+            fail.append((k, 3, f"joint {name} = {value:.4f} outside [{lo:.4f}, {hi:.4f}]"))
+        rot, pos = robot.placements_pinocchio(talos, q)
+        for g, b in robot.terrain_contacts(rot, pos, objects, first_only=False):
+            fail.append((k, 3, f"{robot.names[g]} collides with terrain box {b}"))
+        for ga, gb in robot.self_contacts(rot, pos, first_only=False):
+            fail.append((k, 3, f"{robot.names[ga]} collides with {robot.names[gb]}"))
+
+        # 4. static equilibrium
+        if not contact[k].any():
+            fail.append((k, 4, "no foot in contact"))
+        else:
+            points, normals = sole_corners(feet[contact[k]])
+            equilibrium.set_contacts(points, normals)
+            com = talos.com(q)
+            robustness = equilibrium.robustness(com)
+            if not robustness >= 0.0:
+                fail.append((k, 4, f"not in static equilibrium: robustness {robustness:.4g} < 0 "
+                                   f"(CoM {np.round(com, 4).tolist()}, feet in contact: "
+                                   f"{', '.join(_foot(s) for s in (0, 1) if contact[k, s])})"))
+
+        # 5. one foot at a time, through the air
+        if k > 0 and np.all(np.isfinite(q_all[k - 1])):
+            changed = []
+            for side in (0, 1):
+                before, now = contact[k - 1, side], contact[k, side]
+                if before != now:
+                    changed.append(side)
+                elif now and not _same_placement(feet_all[k - 1, side], feet[side]):
+                    changed.append(side)
+                    fail.append((k, 5, f"{_foot(side)} moves from posture {k - 1} without a posture in the air"))
+            if len(changed) > 1:
+                fail.append((k, 5, f"both feet change between postures {k - 1} and {k}"))
+    return report
+
+
+def _foot(side: int) -> str:
+    return ("left", "right")[side] + " foot"
+
+
+def _angle_between(rot_a: np.ndarray, rot_b: np.ndarray) -> float:
+    """Angle of the rotation rot_a^T rot_b, rad."""
+    cos = (np.trace(rot_a.T @ rot_b) - 1.0) / 2.0
+    return float(math.acos(min(1.0, max(-1.0, cos))))
+
+
+def _same_placement(row_a: np.ndarray, row_b: np.ndarray) -> bool:
+    """Whether two [7] placements are the same (positions and rotation matrices, not quaternion signs)."""
+    if np.max(np.abs(row_a[:3] - row_b[:3])) > SAME_PLACEMENT_TOL:
+        return False
+    diff = matrix_from_quat_xyzw(row_a[3:]) - matrix_from_quat_xyzw(row_b[3:])
+    return bool(np.max(np.abs(diff)) <= SAME_PLACEMENT_TOL)

@@ -55,6 +55,8 @@ class LegDatabase:
         positions: [N, 3] sole positions in the root (base_link) frame, m.
         yaw: [N] sole yaw relative to the root (= hip yaw q1), rad.
         tree: scipy.spatial.cKDTree over `positions`.
+        tree_xy: scipy.spatial.cKDTree over `positions[:, :2]` (vertical-cylinder queries;
+            the root frame is yaw-only, so its z axis is vertical).
     """
 
     side: int
@@ -62,10 +64,17 @@ class LegDatabase:
     positions: np.ndarray
     yaw: np.ndarray
     tree: object
+    tree_xy: object
 
     def near(self, point, radius: float) -> np.ndarray:
         """Indices of the samples within `radius` (m) of `point` [3] (root frame)."""
         return np.asarray(self.tree.query_ball_point(np.asarray(point, dtype=np.float64), radius), dtype=np.int64)
+
+    def near_column(self, point, radius: float, half_height: float) -> np.ndarray:
+        """Indices of the samples in the vertical cylinder of `radius` and +-`half_height` around `point` [3] (root frame)."""
+        point = np.asarray(point, dtype=np.float64)
+        idx = np.asarray(self.tree_xy.query_ball_point(point[:2], radius), dtype=np.int64)
+        return idx[np.abs(self.positions[idx, 2] - point[2]) <= half_height]
 
     @property
     def bounds(self) -> np.ndarray:
@@ -163,7 +172,7 @@ def _from_joints(talos: TalosModel, side: int, q_leg: np.ndarray) -> LegDatabase
         array.setflags(write=False)
     yaw = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
     yaw.setflags(write=False)
-    return LegDatabase(side=side, q=q_leg, positions=pos, yaw=yaw, tree=cKDTree(pos))
+    return LegDatabase(side=side, q=q_leg, positions=pos, yaw=yaw, tree=cKDTree(pos), tree_xy=cKDTree(pos[:, :2]))
 
 
 def _load_or_build(talos: TalosModel, side: int, config: DatabaseConfig) -> np.ndarray:

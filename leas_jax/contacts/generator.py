@@ -64,7 +64,7 @@ class GeneratorConfig:
     max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
     min_knee: float = 0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
     candidate_radius: float = 0.15  # m, database samples this close to a step target are candidates
-    candidate_slab: float = 0.03  # m, samples this close to a face plane are projected on it
+    candidate_slab: float = 0.10  # m, samples this close (vertically) to a face are dropped on it
     candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
     max_candidates: int = 12  # candidates tried per step (in rank order)
     edge_margin: float = 0.01  # m, sole rectangle kept this far inside the face polygon
@@ -254,9 +254,9 @@ class ContactGenerator:
         Returns:
             (pos [N, 3], rot [N, 3, 3]) world sole placements sorted by horizontal
             distance to the target: the target's vertical projection on each nearby
-            face, and the database samples within `candidate_radius` of it and
-            `candidate_slab` of the face, projected on it; at most 4 x max_candidates
-            before the polygon, cover, overlap and reach filters.
+            face, and the database samples within `candidate_radius` of it horizontally
+            and `candidate_slab` vertically, dropped vertically on the face; the 4 x max_candidates closest
+            that pass the polygon and overlap tests go through the cover and reach tests.
         """
         cfg = self.config
         surfaces = self.surfaces
@@ -274,11 +274,11 @@ class ContactGenerator:
             # Vertical projection of the target on the face plane: itself a candidate.
             height = (surfaces.offsets[s] - normal[:2] @ target_pos[:2]) / normal[2]
             on_plane = np.array([target_pos[0], target_pos[1], height])
-            idx = db.near(root_R.T @ (on_plane - root_p), cfg.candidate_radius)
+            idx = db.near_column(root_R.T @ (on_plane - root_p), cfg.candidate_radius, cfg.candidate_slab)
             world = root_p + db.positions[idx] @ root_R.T
-            world = world[np.abs(world @ normal - surfaces.offsets[s]) <= cfg.candidate_slab]
-            # Database samples near the plane, projected on it along the normal.
-            world = world - np.outer(world @ normal - surfaces.offsets[s], normal)
+            # Database samples in a vertical column about the target, dropped vertically
+            # on the face (reachability is re-checked exactly by IK below).
+            world[:, 2] = (surfaces.offsets[s] - world[:, :2] @ normal[:2]) / normal[2]
             points.append(on_plane[None])
             points.append(world)
             owner.append(np.full(len(world) + 1, s))
@@ -289,9 +289,11 @@ class ContactGenerator:
         order = np.argsort(np.hypot(pos[:, 0] - target_pos[0], pos[:, 1] - target_pos[1]), kind="stable")
         pos, owner = pos[order], owner[order]
         # One candidate per grid cell (database samples cluster), the closest to the target.
+        # Keyed by face too: coplanar neighbouring faces (a tread level with a landing)
+        # share dropped samples, and only one of them holds each sole.
         cells = np.round(pos / cfg.candidate_grid).astype(np.int64)
-        _, first = np.unique(cells, axis=0, return_index=True)
-        keep = np.sort(first)[:4 * cfg.max_candidates]
+        _, first = np.unique(np.column_stack([cells, owner]), axis=0, return_index=True)
+        keep = np.sort(first)
         pos, owner = pos[keep], owner[keep]
         rot = sole_rotation(surfaces.normals[owner], target_yaw)
         corners = sole_corners_world(pos, rot)
@@ -301,6 +303,8 @@ class ContactGenerator:
             ok[mine] = np.all(inside_polygon(surfaces.surfaces[s], corners[mine], cfg.edge_margin), axis=1)
         if avoid is not None:
             ok[ok] = ~self._overlaps(pos[ok], rot[ok], *avoid)
+        # The closest few go through the costlier tests.
+        ok[np.cumsum(ok) > 4 * cfg.max_candidates] = False
         probe = np.concatenate([corners[ok], pos[ok][:, None, :]], axis=1).reshape(-1, 3)
         ok[ok] = np.all(uncovered(self.terrain, probe, cfg.cover_tol).reshape(-1, 5), axis=1)
         pos, rot = pos[ok], rot[ok]

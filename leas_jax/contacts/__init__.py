@@ -17,14 +17,17 @@ Attributes are imported lazily so that `import leas_jax.contacts` stays cheap.
 
 import importlib
 
+# Eager: the function `verify` must shadow the submodule of the same name, which
+# becomes a package attribute as soon as it is imported (verify.py imports only NumPy
+# at module level, so this stays cheap).
+from leas_jax.contacts.verify import VerificationReport, verify
+
 _LAZY = {
     "ContactGenerator": "leas_jax.contacts.generator",
     "GeneratorConfig": "leas_jax.contacts.generator",
     "plan_contacts": "leas_jax.contacts.generator",
     "ContactPlan": "leas_jax.contacts.plan",
     "PlanError": "leas_jax.contacts.plan",
-    "verify": "leas_jax.contacts.verify",
-    "VerificationReport": "leas_jax.contacts.verify",
     "validate_paths": "leas_jax.contacts.pool",
     "PathResult": "leas_jax.contacts.pool",
     "ValidationPool": "leas_jax.contacts.pool",
@@ -32,7 +35,7 @@ _LAZY = {
     "load_talos": "leas_jax.contacts.model",
 }
 
-__all__ = sorted(_LAZY)
+__all__ = sorted([*_LAZY, "VerificationReport", "verify"])
 
 
 def __getattr__(name):

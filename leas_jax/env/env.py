@@ -52,7 +52,7 @@ class RootState:
     @property
     def pose(self) -> jax.Array:
         """[4] (x, y, z, yaw), world."""
-        return jnp.concatenate([self.pos, self.yaw[None]])
+        return jnp.concatenate([self.pos, self.yaw[..., None]], axis=-1)
 
 
 def _unit(v: jax.Array) -> jax.Array:

@@ -51,6 +51,7 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
     from leas_jax.eval.geometric import arena_episodes, ground_speed
     from leas_jax.steering.commands import plot_paths
     from leas_jax.terrain import load_terrain
+    from leas_jax.train.config import resolve_data_path
     from leas_jax.train.policy import load_policy
 
     run_dir = Path(run_dir)
@@ -60,7 +61,7 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
     if records:
         plot_learning_curves(records, run_dir / "learning_curves.png")
 
-    arena = load_terrain(config.terrain)
+    arena = load_terrain(config.terrain_path())
     arena_field = heightfield_from_terrain(arena, config.env)
     episodes = arena_episodes(policy, arena_field, n=n_episodes, seed=1)
     show = min(24, n_episodes)
@@ -69,7 +70,7 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
                run_dir / "rollouts_arena.png", title=f"{arena.name}: {show} episodes (red: ended invalid)",
                colors=colors)
 
-    ground = load_terrain(eval_terrain)
+    ground = load_terrain(resolve_data_path(eval_terrain))
     ground_field = heightfield_from_terrain(ground, config.env)
     speed = ground_speed(policy, ground, ground_field, n=n_episodes, seed=2)
     plot_paths(ground, speed.guides[:16], run_dir / "rollouts_ground.png",

@@ -23,9 +23,23 @@ from __future__ import annotations
 import dataclasses
 import json
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from leas_jax.env.config import EnvConfig, HeightmapConfig, ReachabilityConfig, RewardWeights
 from leas_jax.errors import UsageError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+
+
+def resolve_data_path(path: str | Path) -> Path:
+    """A data file (terrain) as given if it exists, else relative to the repository root.
+
+    Lets `terrains/training_arena.toml` work from any working directory.
+    """
+    path = Path(path)
+    if path.exists() or path.is_absolute():
+        return path
+    return REPO_ROOT / path
 
 
 @dataclass(frozen=True)
@@ -54,6 +68,10 @@ class TrainConfig:
     checkpoint_every_s: float = 60.0  # wall-clock seconds between checkpoints
     keep_checkpoints: int = 3
     env: EnvConfig = field(default_factory=EnvConfig)
+
+    def terrain_path(self) -> Path:
+        """The training terrain file: as given, else relative to the repository root."""
+        return resolve_data_path(self.terrain)
 
     @property
     def batch_size(self) -> int:

@@ -89,7 +89,7 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
     run_dir.mkdir(parents=True, exist_ok=True)
     _check_config(run_dir, config)
     if field is None:
-        field = heightfield_from_terrain(load_terrain(config.terrain), config.env)
+        field = heightfield_from_terrain(load_terrain(config.terrain_path()), config.env)
 
     found = checkpoint.list_checkpoints(run_dir)
     state: TrainState = init_state(config, field)

@@ -1,0 +1,78 @@
+"""The `leas` command line: one-line errors with exit code 2, rollout end to end."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from leas_jax.cli import main
+from leas_jax.train import preset, train
+
+ARENA = "terrains/training_arena.toml"
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory):
+    """A tiny policy trained on the real arena (a few seconds)."""
+    out = tmp_path_factory.mktemp("run")
+    config = preset("smoke", num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8, num_minibatches=2,
+                    num_epochs=1, iterations_per_call=2)
+    train(config, out, progress=False)
+    return out
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["train", "--preset", "fast", "--out", "x"], "invalid choice: 'fast'"),
+    (["train", "--out", "x", "--timesteps", "-5"], "expected a positive integer"),
+    (["rollout", "--checkpoint", "nowhere", "--terrain", ARENA, "--start", "1,2", "--target", "3,4",
+      "--out", "g.npz"], "--start expects 3"),
+    (["rollout"], "the following arguments are required"),
+    (["bogus"], "invalid choice: 'bogus'"),
+])
+def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    err = capsys.readouterr().err.strip()
+    assert exit_info.value.code == 2
+    assert len(err.splitlines()) == 1 and fragment in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["rollout", "--checkpoint", "nowhere", "--terrain", ARENA, "--start", "1,2,0", "--target", "3,4",
+      "--out", "g.npz"], "no policy.pkl"),
+    (["train", "--out", "x", "--terrain", "missing.toml"], "--terrain: no such file"),
+    (["terrain", "show", "missing.toml", "--out", "m.png"], "missing.toml"),
+])
+def test_bad_files_are_one_line_with_exit_code_2(capsys, tmp_path, monkeypatch, argv, fragment):
+    monkeypatch.chdir(tmp_path)
+    code = main(argv)
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and fragment in err
+
+
+def test_rollout_writes_guide_and_plot(run_dir, tmp_path, capsys):
+    out = tmp_path / "guide.npz"
+    code = main(["rollout", "--checkpoint", str(run_dir), "--terrain", ARENA, "--start", "3.0,3.0,0.0",
+                 "--target", "6.0,3.0", "--out", str(out)])
+    assert code == 0
+    data = np.load(out)
+    guide = data["guide"]
+    assert guide.ndim == 2 and guide.shape[1] == 4 and len(guide) >= 1
+    np.testing.assert_allclose(guide[0, :2], [3.0, 3.0], atol=1e-5)
+    assert float(data["timestep"]) == pytest.approx(0.1)
+    assert "training_arena" in str(data["terrain"]) and data["target"].tolist() == [6.0, 3.0]
+    assert out.with_suffix(".png").stat().st_size > 10_000
+    assert "poses" in capsys.readouterr().out
+
+
+def test_rollout_rejects_a_start_outside_the_terrain(run_dir, tmp_path, capsys):
+    code = main(["rollout", "--checkpoint", str(run_dir), "--terrain", ARENA, "--start", "30,3,0",
+                 "--target", "6,3", "--out", str(tmp_path / "g.npz")])
+    assert code == 2 and "outside the terrain bounds" in capsys.readouterr().err
+
+
+def test_console_script_runs():
+    """The installed `leas` entry point answers --help without importing JAX errors."""
+    result = subprocess.run([sys.executable, "-m", "leas_jax.cli", "--help"], capture_output=True, text=True)
+    assert result.returncode == 0 and "rollout" in result.stdout and "train" in result.stdout

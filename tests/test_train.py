@@ -1,0 +1,101 @@
+"""Training: config validation, atomic checkpoints, exact resume, policy loading, a real short run."""
+
+import json
+import pickle
+
+import jax
+import numpy as np
+import pytest
+
+from leas_jax.env import heightfield_from_raster
+from leas_jax.errors import LeasError, UsageError
+from leas_jax.train import TrainConfig, load_policy, preset, train
+from leas_jax.train import checkpoint
+
+
+def tiny_config(**overrides):
+    """A few-second config: 64 envs x 8 steps, 2 iterations per call."""
+    base = dict(num_timesteps=64 * 8 * 2 * 3, num_envs=64, unroll_length=8, num_minibatches=2, num_epochs=2,
+                iterations_per_call=2, checkpoint_every_s=0.0)
+    return preset("smoke", **{**base, **overrides})
+
+
+@pytest.fixture(scope="module")
+def field():
+    heights = np.zeros((301, 301), np.float32)
+    heights[200:230, :] = -2.0  # a gap to fall into
+    return heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0)
+
+
+def test_presets_and_validation():
+    assert preset("paper").num_timesteps == 80_000_000
+    assert preset("quick").hidden_sizes == (64, 64)
+    with pytest.raises(UsageError, match="unknown preset 'fast'"):
+        preset("fast")
+    with pytest.raises(UsageError, match="num_envs"):
+        preset("smoke", num_envs=0)
+    with pytest.raises(UsageError, match="multiple of num_minibatches"):
+        preset("smoke", num_envs=100, num_minibatches=16)
+    config = preset("quick", seed=3)
+    assert TrainConfig.from_dict(json.loads(config.to_json())) == config
+    with pytest.raises(UsageError, match="unknown TrainConfig keys: bogus"):
+        TrainConfig.from_dict({**config.to_dict(), "bogus": 1})
+
+
+def test_atomic_write_leaves_no_temporary_files(tmp_path):
+    checkpoint.atomic_write_text(tmp_path / "a.json", "{}")
+    checkpoint.atomic_write_text(tmp_path / "a.json", '{"b": 1}')
+    assert [p.name for p in tmp_path.iterdir()] == ["a.json"]
+    assert json.loads((tmp_path / "a.json").read_text()) == {"b": 1}
+
+
+def test_resume_continues_exactly(tmp_path, field):
+    """3 calls in one go == 1 call, stop, then resume for the remaining 2 (bit for bit)."""
+    config = tiny_config()
+    full = train(config, tmp_path / "full", progress=False, field=field)
+    part = train(config, tmp_path / "split", progress=False, field=field, stop_after_iterations=2)
+    assert part.env_steps == 64 * 8 * 2
+    resumed = train(config, tmp_path / "split", progress=False, field=field)
+    assert resumed.env_steps == full.env_steps == config.num_iterations * config.batch_size
+    a = load_policy(tmp_path / "full")
+    b = load_policy(tmp_path / "split")
+    for x, y in zip(jax.tree.leaves(a.params), jax.tree.leaves(b.params)):
+        np.testing.assert_array_equal(x, y)
+    lines = (tmp_path / "split" / "metrics.jsonl").read_text().splitlines()
+    assert [json.loads(l)["iteration"] for l in lines] == [2, 4, 6]
+    # keep_checkpoints=3: three step files at most, the newest last
+    steps = [s for s, _ in checkpoint.list_checkpoints(tmp_path / "split")]
+    assert steps[-1] == full.env_steps and len(steps) <= 3
+
+
+def test_resume_refuses_a_different_config(tmp_path, field):
+    train(tiny_config(), tmp_path / "run", progress=False, field=field, stop_after_iterations=2)
+    with pytest.raises(UsageError, match="differs in seed"):
+        train(tiny_config(seed=5), tmp_path / "run", progress=False, field=field)
+
+
+def test_policy_file_and_errors(tmp_path, field):
+    train(tiny_config(), tmp_path / "run", progress=False, field=field)
+    policy = load_policy(tmp_path / "run")
+    assert policy.config == tiny_config()
+    action = np.asarray(policy(np.zeros((5, 81), np.float32)))
+    assert action.shape == (5, 4) and np.all(np.abs(action) <= 1.0)
+    with pytest.raises(LeasError, match="no policy.pkl"):
+        load_policy(tmp_path / "nowhere")
+    bad = tmp_path / "bad.pkl"
+    bad.write_bytes(pickle.dumps({"format": "other"}))
+    with pytest.raises(LeasError, match="not a leas policy"):
+        load_policy(bad)
+    bad.write_bytes(b"garbage")
+    with pytest.raises(LeasError, match="cannot read policy"):
+        load_policy(bad)
+
+
+@pytest.mark.slow
+def test_short_ppo_run_improves_the_return(tmp_path, field):
+    """A real 1.5 M-step PPO run on a terrain with a gap: the return clearly rises."""
+    config = preset("smoke", num_timesteps=1_500_000)
+    records = []
+    train(config, tmp_path / "run", progress=False, field=field, on_log=records.append)
+    returns = [r["episode_return"] for r in records if "episode_return" in r]
+    assert np.mean(returns[-3:]) > np.mean(returns[:3]) + 50.0

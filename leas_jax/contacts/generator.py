@@ -37,10 +37,10 @@ import numpy as np
 
 from leas_jax.contacts.collision import robot_collision, terrain_collision
 from leas_jax.contacts.database import DatabaseConfig, leg_database
-from leas_jax.contacts.equilibrium import HppEquilibrium, flat_support_margin, sole_corners
+from leas_jax.contacts.equilibrium import HppEquilibrium, flat_support_margin
 from leas_jax.contacts.ik import leg_ik, leg_ik_single
 from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
-                                     load_talos, quat_xyzw_from_matrix_single, rotz)
+                                     load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
 from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corners_world, sole_rotation,
                                         surface_arrays, uncovered)
@@ -87,6 +87,12 @@ class _Posture:
     guide_index: int
 
 
+def _rotz(yaw: float) -> np.ndarray:
+    """[3, 3] Rz(yaw) for one angle (scalar fast path of model.rotz)."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
 def _placement_row(pos, rot) -> np.ndarray:
     """[7] xyz + quaternion xyzw of a placement (pos [3], rot [3, 3])."""
     return np.concatenate([pos, quat_xyzw_from_matrix_single(rot)])
@@ -116,6 +122,8 @@ class ContactGenerator:
         self._reach = [math.sqrt(leg.thigh ** 2 + leg.shin ** 2 + 2 * leg.thigh * leg.shin * math.cos(config.min_knee))
                        for leg in legs]
         self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
+        self._nominal_xy = [tuple(row[:2].tolist()) for row in self._nominal]
+        self._faces = {}  # face index -> (inward edge normals [E, 3], offsets [E])
         self.stats = {"postures_tried": 0, "candidates": 0}
 
     # ------------------------------------------------------------------ postures
@@ -135,17 +143,19 @@ class ContactGenerator:
 
     def _root_height(self, guide_pose, root_xy, root_R, contacts) -> float | None:
         """Root z: the guide's, lowered (<= max_root_offset_z) so that no contact leg is overstretched."""
-        z = guide_pose[2]
+        z = float(guide_pose[2])
+        cos_yaw, sin_yaw = float(root_R[0, 0]), float(root_R[1, 0])
         for side, pos, rot in contacts:
             leg = self.talos.legs[side]
-            ankle = pos + leg.sole_depth * rot[:, 2]
-            hip_xy = root_xy + (root_R @ leg.hip_offset)[:2]
-            horizontal = float(np.hypot(*(hip_xy - ankle[:2])))
+            hx, hy, hz = leg.hip_offset.tolist()
+            ankle = (pos + leg.sole_depth * rot[:, 2]).tolist()
+            hip_x = float(root_xy[0]) + cos_yaw * hx - sin_yaw * hy
+            hip_y = float(root_xy[1]) + sin_yaw * hx + cos_yaw * hy
+            horizontal = math.hypot(hip_x - ankle[0], hip_y - ankle[1])
             reach = self._reach[side]
             if horizontal >= reach:
                 return None
-            top = ankle[2] + math.sqrt(reach * reach - horizontal * horizontal) - leg.hip_offset[2]
-            z = min(z, top)
+            z = min(z, ankle[2] + math.sqrt(reach * reach - horizontal * horizontal) - hz)
         if guide_pose[2] - z > self.config.max_root_offset_z:
             return None
         return z
@@ -167,7 +177,7 @@ class ContactGenerator:
         """
         cfg = self.config
         self.stats["postures_tried"] += 1
-        root_R = rotz(guide_pose[3])
+        root_R = _rotz(guide_pose[3])
         guide_xy = np.asarray(guide_pose[:2], dtype=np.float64)
         support_centre = np.mean([pos[:2] for _, pos, _ in contacts], axis=0)
         target = support_centre if com_target is None else np.asarray(com_target)
@@ -217,7 +227,8 @@ class ContactGenerator:
                 else:
                     shift = shift + error
                     continue
-            points, normals = sole_corners(feet)
+            points = np.concatenate([pos + SOLE_CORNERS @ rot.T for _, pos, rot in contacts])
+            normals = np.repeat(np.array([rot[:, 2] for _, _, rot in contacts]), 4, axis=0)
             if flat_support_margin(points, normals, com) < cfg.flat_com_margin:
                 self.equilibrium.set_contacts(points, normals)
                 if self.equilibrium.robustness(com) < cfg.min_robustness:
@@ -235,7 +246,7 @@ class ContactGenerator:
 
     def _nominal_placement(self, guide_pose, side: int) -> tuple[np.ndarray, float]:
         """World (x, y, z) of a sole at its half-sitting place under a guide pose, and its yaw."""
-        root_R = rotz(guide_pose[3])
+        root_R = _rotz(guide_pose[3])
         pos = np.asarray(guide_pose[:3], dtype=np.float64) + root_R @ self._nominal[side]
         return pos, float(guide_pose[3])
 
@@ -261,53 +272,56 @@ class ContactGenerator:
         cfg = self.config
         surfaces = self.surfaces
         db = self.databases[side]
-        root_R = rotz(guide_pose[3])
+        root_R = _rotz(guide_pose[3])
         root_p = np.asarray(guide_pose[:3], dtype=np.float64)
         target_pos = np.asarray(target_pos, dtype=np.float64)
         empty = np.zeros((0, 3)), np.zeros((0, 3, 3))
         reach = cfg.candidate_radius + 0.5 * math.hypot(SOLE_LENGTH, SOLE_WIDTH)
         near = np.nonzero(np.all((surfaces.bbox[:, 0, :2] - reach <= target_pos[:2]) &
                                  (surfaces.bbox[:, 1, :2] + reach >= target_pos[:2]), axis=1))[0]
-        points, owner = [], []
+        points, owner, rotations = [], [], []
         for s in near:
             normal = surfaces.normals[s]
             # Vertical projection of the target on the face plane: itself a candidate.
             height = (surfaces.offsets[s] - normal[:2] @ target_pos[:2]) / normal[2]
             on_plane = np.array([target_pos[0], target_pos[1], height])
             idx = db.near_column(root_R.T @ (on_plane - root_p), cfg.candidate_radius, cfg.candidate_slab)
-            world = root_p + db.positions[idx] @ root_R.T
+            world = np.vstack([on_plane, root_p + db.positions[idx] @ root_R.T])
             # Database samples in a vertical column about the target, dropped vertically
             # on the face (reachability is re-checked exactly by IK below).
             world[:, 2] = (surfaces.offsets[s] - world[:, :2] @ normal[:2]) / normal[2]
-            points.append(on_plane[None])
-            points.append(world)
-            owner.append(np.full(len(world) + 1, s))
+            rot = sole_rotation(normal[None], target_yaw)[0]
+            inside = self._inside_face(s, world, rot)
+            points.append(world[inside])
+            owner.append(np.full(int(inside.sum()), s))
+            rotations.append(rot)
         if not points:
             return empty
         pos = np.concatenate(points)
         owner = np.concatenate(owner)
         order = np.argsort(np.hypot(pos[:, 0] - target_pos[0], pos[:, 1] - target_pos[1]), kind="stable")
         pos, owner = pos[order], owner[order]
-        # One candidate per grid cell (database samples cluster), the closest to the target.
-        # Keyed by face too: coplanar neighbouring faces (a tread level with a landing)
-        # share dropped samples, and only one of them holds each sole.
-        cells = np.round(pos / cfg.candidate_grid).astype(np.int64)
-        _, first = np.unique(np.column_stack([cells, owner]), axis=0, return_index=True)
+        # One candidate per grid cell and face (database samples cluster; coplanar
+        # neighbouring faces share dropped samples), the closest to the target.
+        cells = np.round((pos[:, :2] - target_pos[:2]) / cfg.candidate_grid).astype(np.int64) + 1000
+        key = (cells[:, 0] * 2000 + cells[:, 1]) * (len(surfaces) + 1) + owner
+        _, first = np.unique(key, return_index=True)
         keep = np.sort(first)
         pos, owner = pos[keep], owner[keep]
-        rot = sole_rotation(surfaces.normals[owner], target_yaw)
-        corners = sole_corners_world(pos, rot)
-        ok = np.zeros(len(pos), dtype=bool)
-        for s in np.unique(owner):
-            mine = owner == s
-            ok[mine] = np.all(inside_polygon(surfaces.surfaces[s], corners[mine], cfg.edge_margin), axis=1)
-        if avoid is not None:
-            ok[ok] = ~self._overlaps(pos[ok], rot[ok], *avoid)
+        rot_of = {s: r for s, r in zip(near, rotations)}
+        rot = np.stack([rot_of[s] for s in owner]) if len(owner) else np.zeros((0, 3, 3))
+        ok = np.ones(len(pos), dtype=bool)
+        if avoid is not None and len(pos):
+            ok = ~self._overlaps(pos, rot, *avoid)
         # The closest few go through the costlier tests.
         ok[np.cumsum(ok) > 4 * cfg.max_candidates] = False
-        probe = np.concatenate([corners[ok], pos[ok][:, None, :]], axis=1).reshape(-1, 3)
-        ok[ok] = np.all(uncovered(self.terrain, probe, cfg.cover_tol).reshape(-1, 5), axis=1)
         pos, rot = pos[ok], rot[ok]
+        if len(pos) == 0:
+            return empty
+        corners = sole_corners_world(pos, rot)
+        probe = np.concatenate([corners, pos[:, None, :]], axis=1).reshape(-1, 3)
+        free = np.all(uncovered(self.terrain, probe, cfg.cover_tol).reshape(-1, 5), axis=1)
+        pos, rot = pos[free], rot[free]
         # Reachable within the joint limits from the guide root or the lowest allowed root.
         leg = self.talos.legs[side]
         reachable = np.zeros(len(pos), dtype=bool)
@@ -317,6 +331,25 @@ class ContactGenerator:
             reachable |= within & np.all((q >= leg.lower) & (q <= leg.upper), axis=1)
         self.stats["candidates"] += int(reachable.sum())
         return pos[reachable], rot[reachable]
+
+    def _inside_face(self, s: int, centres: np.ndarray, rot: np.ndarray) -> np.ndarray:
+        """[N] whether soles with centres [N, 3] on face s and orientation rot [3, 3] lie
+        inside its polygon, `edge_margin` from the edges.
+
+        The rectangle is inside the convex polygon iff its centre is inside the polygon
+        shrunk, edge by edge, by the rectangle's half-extent along the edge's inward
+        normal m: |m . x_sole| L/2 + |m . y_sole| W/2 (one matrix product for all centres).
+        """
+        if s not in self._faces:
+            face = self.surfaces.surfaces[s]
+            verts = face.vertices
+            inward = np.cross(face.normal, np.roll(verts, -1, axis=0) - verts)
+            inward /= np.linalg.norm(inward, axis=1, keepdims=True)
+            self._faces[s] = (inward, np.einsum("ei,ei->e", inward, verts))
+        inward, offsets = self._faces[s]
+        extent = np.abs(inward @ rot[:, 0]) * SOLE_LENGTH / 2 + np.abs(inward @ rot[:, 1]) * SOLE_WIDTH / 2
+        bound = offsets + extent + self.config.edge_margin
+        return np.all(centres @ inward.T >= bound, axis=1)
 
     def _overlaps(self, pos, rot, other_pos, other_rot) -> np.ndarray:
         """[N] whether sole rectangles (pos [N,3], rot [N,3,3]) come within feet_gap of another sole.
@@ -342,12 +375,13 @@ class ContactGenerator:
 
     def _foot_lag(self, guide_pose, side, pos, rot) -> tuple[float, float]:
         """(horizontal distance, |yaw difference|) of a sole to its nominal place under a guide pose."""
-        root_R = rotz(guide_pose[3])
-        local = root_R.T @ (pos - np.asarray(guide_pose[:3]))
-        dist = float(np.hypot(*(local[:2] - self._nominal[side][:2])))
-        yaw = math.atan2(rot[1, 0], rot[0, 0]) - guide_pose[3]
-        yaw = abs((yaw + math.pi) % (2 * math.pi) - math.pi)
-        return dist, yaw
+        yaw0 = float(guide_pose[3])
+        c, s = math.cos(yaw0), math.sin(yaw0)
+        dx, dy = float(pos[0] - guide_pose[0]), float(pos[1] - guide_pose[1])
+        nx, ny = self._nominal_xy[side]
+        dist = math.hypot(c * dx + s * dy - nx, -s * dx + c * dy - ny)
+        yaw = math.atan2(rot[1, 0], rot[0, 0]) - yaw0
+        return dist, abs((yaw + math.pi) % (2 * math.pi) - math.pi)
 
     def _comfortable(self, guide_pose, contacts) -> bool:
         cfg = self.config
@@ -370,7 +404,7 @@ class ContactGenerator:
         old_pos, old_rot = feet[side]
         lifted = [(old_pos + np.array([0.0, 0.0, cfg.swing_lift]), old_rot)]
         nominal_pos, _ = self._nominal_placement(pose, side)
-        lifted.append((nominal_pos + np.array([0.0, 0.0, cfg.swing_lift]), rotz(pose[3])))
+        lifted.append((nominal_pos + np.array([0.0, 0.0, cfg.swing_lift]), _rotz(pose[3])))
         single = self._posture(pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2])
         if single is None:
             return None

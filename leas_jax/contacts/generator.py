@@ -308,8 +308,7 @@ class ContactGenerator:
         _, first = np.unique(key, return_index=True)
         keep = np.sort(first)
         pos, owner = pos[keep], owner[keep]
-        rot_of = {s: r for s, r in zip(near, rotations)}
-        rot = np.stack([rot_of[s] for s in owner]) if len(owner) else np.zeros((0, 3, 3))
+        rot = np.stack(rotations)[np.searchsorted(near, owner)]
         ok = np.ones(len(pos), dtype=bool)
         if avoid is not None and len(pos):
             ok = ~self._overlaps(pos, rot, *avoid)

@@ -73,7 +73,8 @@ class GeneratorConfig:
     swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
     min_robustness: float = 1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
     # m, on horizontal faces a CoM this far inside the support polygon is in equilibrium
-    # without solving the LP (equilibrium.flat_support_margin; robustness > 4 there)
+    # without solving the LP (equilibrium.flat_support_margin); 1.5 cm is ~5 x the CoM
+    # margin of min_robustness, so the shortcut never accepts what the LP would reject
     flat_com_margin: float = 0.015
     database: DatabaseConfig = field(default_factory=DatabaseConfig)
 

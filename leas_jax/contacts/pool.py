@@ -169,48 +169,36 @@ def _one_line(exc: BaseException) -> str:
 class PathRunner:
     """Plans single paths; lives in a worker (or in the caller for workers=0). Host-only.
 
-    Built once per worker from a `WorkerSpec`: loads the terrain and the planner
-    (the Talos model and its sample database are built here, not per path).
-    A remote backend (see `register_backend`) instantiates it on its workers.
+    Built once per worker from a `WorkerSpec`: loads the terrain and, for the
+    default planner, one `ContactGenerator` (Talos model, sample database,
+    terrain collision objects, support surfaces), reused for every path. A
+    remote backend (see `register_backend`) instantiates it on its workers.
+
+    The generator is deterministic given (terrain, guide, timestep, config);
+    `GeneratorConfig` has no seed field, so the path seed only reaches the
+    global NumPy and `random` generators. An injected `plan_fn` whose config
+    has a `seed` field gets the path seed there too.
 
     Args:
         spec: terrain text, config and planner.
-        warm_up: build the generator's cached model now (workers) rather than
-            on the first path (in-process use).
     """
 
-    def __init__(self, spec: WorkerSpec, warm_up: bool = True):
+    def __init__(self, spec: WorkerSpec):
         from leas_jax.terrain import loads_terrain
 
         self.terrain = loads_terrain(spec.terrain_text, source=spec.terrain_source)
+        self._generator = None
         if spec.plan_fn is None:
             # Imported here, not at module level: leas_jax.contacts imports this
-            # module, and only workers need the generator.
-            from leas_jax.contacts import GeneratorConfig, plan_contacts
+            # module lazily, and only workers need the generator.
+            from leas_jax.contacts.generator import ContactGenerator, GeneratorConfig
 
             self.config = spec.config if spec.config is not None else GeneratorConfig()
-            self.plan_fn = plan_contacts
-            if warm_up:
-                self._warm_up()
+            self._generator = ContactGenerator(self.terrain, self.config)
+            self.plan_fn = None
         else:
             self.config = spec.config
             self.plan_fn = spec.plan_fn
-
-    def _warm_up(self) -> None:
-        """Build the cached Talos model and sample database now, once per worker.
-
-        The generator caches them at module level on first use; planning a
-        one-pose guide triggers that without depending on its private names.
-        """
-        xy = 0.5 * (self.terrain.bounds[0] + self.terrain.bounds[1])
-        z = float(self.terrain.height_at(xy[None, :])[0]) + 1.0
-        guide = np.array([[xy[0], xy[1], z, 0.0]] * 2)
-        try:
-            self.plan_fn(self.terrain, guide, 0.1, self.config)
-        except Exception:
-            # A failing warm-up path (e.g. the terrain centre is a hole) still
-            # loaded the model; real paths report their own errors.
-            pass
 
     def _config_for(self, seed: int):
         """The config with its `seed` field (if it has one) set to the path seed."""
@@ -218,6 +206,11 @@ class PathRunner:
         if dataclasses.is_dataclass(config) and any(f.name == "seed" for f in dataclasses.fields(config)):
             config = dataclasses.replace(config, seed=seed)
         return config
+
+    def _plan(self, guide: np.ndarray, timestep: float, seed: int):
+        if self._generator is not None:
+            return self._generator.plan(guide, timestep)
+        return self.plan_fn(self.terrain, guide, timestep, self._config_for(seed))
 
     def run(self, index: int, guide: np.ndarray, timestep: float, seed: int, attempts: int = 1) -> PathResult:
         """Plan one path; planner exceptions become an error result.
@@ -236,7 +229,7 @@ class PathRunner:
         random.seed(seed)
         start = time.perf_counter()
         try:
-            plan = self.plan_fn(self.terrain, guide, timestep, self._config_for(seed))
+            plan = self._plan(guide, timestep, seed)
             coverage = float(plan.coverage)
             last_valid = int(plan.last_valid_index)
         except Exception as exc:
@@ -308,8 +301,7 @@ class _InlineBackend:
     workers = 0
 
     def __init__(self, spec: WorkerSpec):
-        # No warm-up: in the caller's process the model loads on the first path anyway.
-        self._runner = PathRunner(spec, warm_up=False)
+        self._runner = PathRunner(spec)
         self._closed = False
 
     def submit(self, guides, timestep, seeds):

@@ -107,7 +107,8 @@ class PathResult:
             [0, 1]; 0.0 when `error` is set.
         last_valid_index: guide index of the last valid posture (DESIGN §6);
             -1 when `error` is set (no part of the guide was validated).
-        plan: the `ContactPlan`, or None when `error` is set.
+        plan: the `ContactPlan`; None when `error` is set or the pool was made
+            with `return_plans=False`.
         error: None on success, else one line "Type: message" (an exception
             raised by the planner, a worker death, a timeout).
         attempts: how many times the path was started (2 after a worker died
@@ -141,12 +142,16 @@ class WorkerSpec:
         config: the generator config (`GeneratorConfig`), None for its defaults.
         plan_fn: None for `leas_jax.contacts.plan_contacts`, else a picklable
             module-level function `(terrain, guide [T, 4], timestep, config) -> plan`.
+        return_plans: False to drop each plan in the worker and send back only
+            coverage and last_valid_index (the trainer needs no more; a plan
+            carries the terrain text, ~40 kB for the training arena).
     """
 
     terrain_text: str
     terrain_source: str = "<terrain>"
     config: Any = None
     plan_fn: Callable | None = None
+    return_plans: bool = True
 
 
 def path_seed(base_seed: int, index: int) -> int:
@@ -187,6 +192,7 @@ class PathRunner:
         from leas_jax.terrain import loads_terrain
 
         self.terrain = loads_terrain(spec.terrain_text, source=spec.terrain_source)
+        self.return_plans = spec.return_plans
         self._generator = None
         if spec.plan_fn is None:
             # Imported here, not at module level: leas_jax.contacts imports this
@@ -237,7 +243,8 @@ class PathRunner:
                               error=_one_line(exc), attempts=attempts,
                               seconds=time.perf_counter() - start,
                               traceback=traceback_module.format_exc())
-        return PathResult(index=index, coverage=coverage, last_valid_index=last_valid, plan=plan,
+        return PathResult(index=index, coverage=coverage, last_valid_index=last_valid,
+                          plan=plan if self.return_plans else None,
                           error=None, attempts=attempts, seconds=time.perf_counter() - start)
 
 
@@ -653,7 +660,7 @@ def _default_workers() -> int:
     return max(1, cpus - 1)
 
 
-def _terrain_spec(terrain, config, plan_fn) -> WorkerSpec:
+def _terrain_spec(terrain, config, plan_fn, return_plans: bool) -> WorkerSpec:
     """Check the terrain in the parent (clear error now, not in a worker) and pack the spec."""
     from leas_jax.terrain import Terrain, loads_terrain
 
@@ -666,7 +673,8 @@ def _terrain_spec(terrain, config, plan_fn) -> WorkerSpec:
         raise UsageError(f"terrain: expected a Terrain or the terrain file text, got {type(terrain).__name__}")
     if plan_fn is not None and not callable(plan_fn):
         raise UsageError(f"plan_fn: expected a function, got {type(plan_fn).__name__}")
-    return WorkerSpec(terrain_text=text, terrain_source=source, config=config, plan_fn=plan_fn)
+    return WorkerSpec(terrain_text=text, terrain_source=source, config=config, plan_fn=plan_fn,
+                      return_plans=bool(return_plans))
 
 
 def _check_guides(guides, timestep) -> list[np.ndarray]:
@@ -715,12 +723,14 @@ class ValidationPool:
             leaks in native code); None: never.
         start_method: "spawn" or "forkserver" ("fork" is refused: JAX threads
             in the parent do not survive it).
+        return_plans: False to get results without their `plan` (only
+            coverage and last_valid_index travel back: what the trainer uses).
     """
 
     def __init__(self, terrain, *, workers: int | None = None, config=None, plan_fn: Callable | None = None,
                  address: str | None = None, task_timeout: float | None = DEFAULT_TASK_TIMEOUT,
                  max_attempts: int = DEFAULT_MAX_ATTEMPTS, max_tasks_per_worker: int | None = None,
-                 start_method: str = "spawn"):
+                 start_method: str = "spawn", return_plans: bool = True):
         if workers is not None and (not isinstance(workers, (int, np.integer)) or isinstance(workers, bool)
                                     or workers < 0):
             raise UsageError(f"workers: expected an integer >= 0, got {workers!r}")
@@ -731,7 +741,7 @@ class ValidationPool:
             raise UsageError(f"max_attempts: expected an integer >= 1, got {max_attempts!r}")
         if task_timeout is not None and not task_timeout > 0:
             raise UsageError(f"task_timeout: expected a positive number of seconds or None, got {task_timeout!r}")
-        spec = _terrain_spec(terrain, config, plan_fn)
+        spec = _terrain_spec(terrain, config, plan_fn, return_plans)
         self._base_seed = int(getattr(config, "seed", 0) or 0)
         self._backend: Backend
         if address is not None:
@@ -798,7 +808,7 @@ class ValidationPool:
 def validate_paths(terrain, guides: Sequence[np.ndarray], timestep: float, workers: int | None = None,
                    config=None, *, plan_fn: Callable | None = None, address: str | None = None,
                    task_timeout: float | None = DEFAULT_TASK_TIMEOUT,
-                   max_attempts: int = DEFAULT_MAX_ATTEMPTS) -> list[PathResult]:
+                   max_attempts: int = DEFAULT_MAX_ATTEMPTS, return_plans: bool = True) -> list[PathResult]:
     """Run the contact generator on every guide path, in parallel (host-only).
 
     One-shot form of `ValidationPool`: starts at most `len(guides)` workers,
@@ -810,7 +820,7 @@ def validate_paths(terrain, guides: Sequence[np.ndarray], timestep: float, worke
         timestep: s between guide poses.
         workers: processes (None: CPUs - 1; 0: in the calling thread).
         config: `GeneratorConfig` (None: defaults).
-        plan_fn, address, task_timeout, max_attempts: see `ValidationPool`.
+        plan_fn, address, task_timeout, max_attempts, return_plans: see `ValidationPool`.
 
     Returns:
         list[PathResult], `results[i].index == i`; a path whose planner raised,
@@ -824,5 +834,6 @@ def validate_paths(terrain, guides: Sequence[np.ndarray], timestep: float, worke
     elif workers and address is None:
         workers = min(int(workers), len(checked))
     with ValidationPool(terrain, workers=workers, config=config, plan_fn=plan_fn, address=address,
-                        task_timeout=task_timeout, max_attempts=max_attempts) as pool:
+                        task_timeout=task_timeout, max_attempts=max_attempts,
+                        return_plans=return_plans) as pool:
         return pool.map(checked, timestep)

@@ -84,3 +84,29 @@ def test_one_and_two_workers_give_the_same_plans(inline_results):
     assert [r.index for r in again] == [0, 1]
     _same_plans([r for r in again], [PathResult(**{**vars(r), "index": i}) for i, r in enumerate(inline_results[3:])])
     assert verify(two[1].plan).ok  # a plan that came back through a pipe still verifies
+
+
+def test_worker_killed_from_outside_mid_batch(inline_results):
+    """SIGKILL (as the OOM killer would) a worker at an arbitrary moment: every path still
+    gets the plan it gets in-process, the lost one after a retry on a fresh worker."""
+    import os
+    import signal
+    import time
+
+    guides = GUIDES * 4
+    with ValidationPool(TERRAIN, workers=1) as pool:
+        future = pool.submit(guides, DT)
+        backend = pool._backend  # white-box: the pid of the running worker
+        deadline = time.monotonic() + 60
+        while not any(w.ready for w in backend._pool) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        victim = next(w.pid for w in backend._pool if w.ready)
+        time.sleep(0.3)  # a few paths in
+        os.kill(victim, signal.SIGKILL)
+        results = future.result(timeout=120)
+        assert victim not in {w.pid for w in backend._pool}
+    assert [r.index for r in results] == list(range(len(guides)))
+    assert all(r.ok and r.attempts in (1, 2) for r in results)
+    for got, want in zip(results, inline_results * 4):
+        assert (got.coverage, got.last_valid_index) == (want.coverage, want.last_valid_index)
+        np.testing.assert_array_equal(got.plan.q, want.plan.q)

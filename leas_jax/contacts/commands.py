@@ -23,11 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from leas_jax.errors import LeasError, UsageError
-
 # Keys `ContactPlan.save` writes (DESIGN §6); checked before loading so a
 # truncated or foreign file is named with the missing key.
-PLAN_KEYS = ("q", "feet", "guide_index", "last_valid_index", "coverage", "terrain", "guide")
+from leas_jax.contacts.plan import PLAN_KEYS
+from leas_jax.errors import LeasError, UsageError
 
 
 @dataclass(frozen=True)

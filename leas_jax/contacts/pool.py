@@ -352,6 +352,7 @@ class _Worker:
     timed_out: bool = False
     tasks_done: int = 0
     retiring: bool = False
+    eof: bool = False  # its pipe is closed: watch only the sentinel (no busy loop on EOF)
 
 
 def _describe_exit(exitcode: int | None) -> str:
@@ -573,7 +574,8 @@ class _ProcessBackend:
                     timeout = self._check_timeouts()
                     watched = {self._wake_reader: None}
                     for worker in self._pool:
-                        watched[worker.conn] = worker
+                        if not worker.eof:
+                            watched[worker.conn] = worker
                         watched[worker.process.sentinel] = worker
                 for ready in wait_for_ready(list(watched), timeout=timeout):
                     if ready is self._wake_reader:
@@ -586,10 +588,10 @@ class _ProcessBackend:
                             continue
                         # Drain answers first: a worker may send its result and die.
                         try:
-                            while worker.conn.poll():
+                            while not worker.eof and worker.conn.poll():
                                 self._on_message(worker, worker.conn.recv())
                         except (EOFError, OSError):
-                            pass
+                            worker.eof = True
                         if not worker.process.is_alive():
                             self._on_death(worker)
         except BaseException as exc:  # noqa: BLE001 - a dispatcher bug must not hang callers

@@ -16,9 +16,9 @@ _LAZY = {
     "Terrain": "leas_jax.terrain",
     "LeasEnv": "leas_jax.env",
     "EnvParams": "leas_jax.env",
-    "TrainConfig": "leas_jax.train",
-    "train": "leas_jax.train",
-    "load_policy": "leas_jax.train",
+    "TrainConfig": "leas_jax.training",
+    "train": "leas_jax.training",
+    "load_policy": "leas_jax.training",
     "rollout": "leas_jax.steering",
 }
 

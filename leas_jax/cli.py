@@ -25,7 +25,7 @@ def build_parser() -> argparse.ArgumentParser:
     from leas_jax.contacts import commands as contacts_commands
     from leas_jax.steering import commands as steering_commands
     from leas_jax.terrain import commands as terrain_commands
-    from leas_jax.train import commands as train_commands
+    from leas_jax.training import commands as train_commands
 
     parser = OneLineErrorParser(prog="leas", description="LeaS: learn to steer a locomotion contact planner.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)

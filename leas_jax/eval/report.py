@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from leas_jax.train.checkpoint import atomic_write_text
+from leas_jax.training.checkpoint import atomic_write_text
 
 GROUND_SPEED_TARGET = 0.12  # m/s, foundation issue acceptance figure
 ARENA_VALID_TARGET = 0.90  # fraction of arena episodes without an invalid pose
@@ -51,8 +51,8 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
     from leas_jax.eval.geometric import arena_episodes, ground_speed
     from leas_jax.steering.commands import plot_paths
     from leas_jax.terrain import load_terrain
-    from leas_jax.train.config import resolve_data_path
-    from leas_jax.train.policy import load_policy
+    from leas_jax.training.config import resolve_data_path
+    from leas_jax.training.policy import load_policy
 
     run_dir = Path(run_dir)
     policy = load_policy(run_dir)

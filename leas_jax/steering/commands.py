@@ -26,7 +26,7 @@ def save_guide(path: Path, guide: np.ndarray, timestep: float, terrain_text: str
     """Write a guide file (DESIGN §6): guide [T, 4], timestep, terrain text, target [2]; atomic."""
     import io
 
-    from leas_jax.train.checkpoint import atomic_write_bytes
+    from leas_jax.training.checkpoint import atomic_write_bytes
 
     buffer = io.BytesIO()
     np.savez(buffer, guide=np.asarray(guide, np.float64), timestep=np.float64(timestep),
@@ -68,7 +68,7 @@ def plot_paths(terrain, paths, path: Path, title: str = "", colors=None, target=
 def cmd_rollout(args) -> int:
     from leas_jax.steering.leas import rollout
     from leas_jax.terrain import load_terrain
-    from leas_jax.train.policy import load_policy
+    from leas_jax.training.policy import load_policy
 
     out = Path(args.out)
     if out.suffix != ".npz":

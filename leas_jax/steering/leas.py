@@ -116,7 +116,7 @@ def rollout_batch(policy, field: Heightfield, starts: np.ndarray, targets, speed
     """Roll the deterministic policy from N starts.
 
     Args:
-        policy: a `leas_jax.train.Policy`.
+        policy: a `leas_jax.training.Policy`.
         field: terrain heightfield.
         starts: [N, 4] (x, y, z, yaw) world poses.
         targets: [N, 2] target points, or [N, W, 2] waypoint lists (same W for all;
@@ -150,7 +150,7 @@ def rollout(policy, terrain, start, target, speed: float = 0.0, max_steps: int |
     """Guide path of the policy from one start to a target.
 
     Args:
-        policy: a `leas_jax.train.Policy` (see `load_policy`).
+        policy: a `leas_jax.training.Policy` (see `load_policy`).
         terrain: a `leas_jax.terrain.Terrain`.
         start: (x, y, yaw) world; z is set at the nominal height above the terrain.
         target: (x, y) world target point (the last one when `waypoints` are given).

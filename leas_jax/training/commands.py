@@ -19,7 +19,7 @@ def _positive_int(text: str) -> int:
 
 
 def _add_training_arguments(parser) -> None:
-    from leas_jax.train.config import PRESETS
+    from leas_jax.training.config import PRESETS
 
     parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
                         help="smoke (< 1 min), quick (~10 min on 2 cores), paper (80 M steps)")
@@ -34,7 +34,7 @@ def _add_training_arguments(parser) -> None:
 
 def config_from_args(args):
     """TrainConfig of the parsed `leas train` / `leas run` arguments."""
-    from leas_jax.train.config import preset
+    from leas_jax.training.config import preset
 
     overrides = {}
     if args.seed is not None:
@@ -51,7 +51,7 @@ def config_from_args(args):
 
 
 def cmd_train(args) -> int:
-    from leas_jax.train.loop import train
+    from leas_jax.training.loop import train
 
     config = config_from_args(args)
     result = train(config, args.out, progress=not args.no_progress)
@@ -63,7 +63,7 @@ def cmd_train(args) -> int:
 
 def cmd_run(args) -> int:
     from leas_jax.eval.report import write_report
-    from leas_jax.train.loop import train
+    from leas_jax.training.loop import train
 
     config = config_from_args(args)
     result = train(config, args.out, progress=not args.no_progress)

@@ -12,9 +12,9 @@ import jax
 import numpy as np
 
 from leas_jax.errors import UsageError
-from leas_jax.train import checkpoint
-from leas_jax.train.config import TrainConfig
-from leas_jax.train.ppo import TrainState, init_state, make_train_call
+from leas_jax.training import checkpoint
+from leas_jax.training.config import TrainConfig
+from leas_jax.training.ppo import TrainState, init_state, make_train_call
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,7 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
     """Train a LeaS policy with geometric PPO; resume if `out` holds a checkpoint.
 
     Args:
-        config: training configuration (see `leas_jax.train.config.preset`).
+        config: training configuration (see `leas_jax.training.config.preset`).
         out: run directory (created); an existing one with checkpoints resumes.
         progress: show a tqdm progress bar.
         on_log: called with every log record (also written to metrics.jsonl).

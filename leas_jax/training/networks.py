@@ -7,7 +7,7 @@ import jax
 from brax.training.acme import running_statistics
 from brax.training.agents.ppo import networks as ppo_networks
 
-from leas_jax.train.config import TrainConfig
+from leas_jax.training.config import TrainConfig
 
 
 def make_networks(config: TrainConfig) -> ppo_networks.PPONetworks:

@@ -11,8 +11,8 @@ from typing import Any
 import jax
 
 from leas_jax.errors import LeasError
-from leas_jax.train.config import TrainConfig
-from leas_jax.train.networks import deterministic_policy_fn
+from leas_jax.training.config import TrainConfig
+from leas_jax.training.networks import deterministic_policy_fn
 
 
 @dataclass(frozen=True)

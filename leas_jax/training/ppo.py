@@ -26,8 +26,8 @@ from flax import struct
 
 from leas_jax.env import FreshResetVmap, LeasEnv
 from leas_jax.env.field import Heightfield
-from leas_jax.train.config import TrainConfig
-from leas_jax.train.networks import make_networks
+from leas_jax.training.config import TrainConfig
+from leas_jax.training.networks import make_networks
 
 
 @struct.dataclass

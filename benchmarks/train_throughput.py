@@ -1,0 +1,70 @@
+"""Geometric PPO throughput (env steps per second, learning included).
+
+For each preset (and optional overrides), compiles one training call, then
+times `--calls` calls. Writes results/train_throughput.json.
+
+    python benchmarks/train_throughput.py [--presets quick,paper] [--calls 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import jax  # noqa: E402
+
+from common import save  # noqa: E402
+
+
+def measure(config, field, calls: int) -> dict:
+    from leas_jax.training.ppo import init_state, make_train_call
+
+    state = init_state(config, field)
+    call = make_train_call(config)
+    t0 = time.perf_counter()
+    state, metrics = call(state, field)
+    jax.block_until_ready(metrics)
+    compile_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    for _ in range(calls):
+        state, metrics = call(state, field)
+    jax.block_until_ready(metrics)
+    run_s = time.perf_counter() - t0
+    steps = calls * config.iterations_per_call * config.batch_size
+    return {"preset": config.preset, "num_envs": config.num_envs, "unroll_length": config.unroll_length,
+            "num_minibatches": config.num_minibatches, "num_epochs": config.num_epochs,
+            "compile_s": round(compile_s, 2), "run_s": round(run_s, 3), "env_steps": steps,
+            "env_steps_per_s": round(steps / run_s),
+            "minutes_for_80M_steps": round(80e6 / (steps / run_s) / 60, 1)}
+
+
+def main() -> None:
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.config import preset
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--presets", default="quick,paper")
+    parser.add_argument("--calls", type=int, default=5)
+    parser.add_argument("--epochs", default="", help="also measure these num_epochs values, e.g. 10,4")
+    args = parser.parse_args()
+    rows = []
+    for name in args.presets.split(","):
+        config = preset(name)
+        field = heightfield_from_terrain(load_terrain(config.terrain_path()), config.env)
+        variants = [config] + [preset(name, num_epochs=int(e)) for e in args.epochs.split(",") if e]
+        for variant in variants:
+            row = measure(variant, field, args.calls)
+            rows.append(row)
+            print(f"{name:6s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
+                  f"{row['env_steps_per_s']:>10,} env steps/s, 80 M steps in {row['minutes_for_80M_steps']} min "
+                  f"(compile {row['compile_s']} s)", flush=True)
+    save("train_throughput", {"rows": rows})
+
+
+if __name__ == "__main__":
+    main()

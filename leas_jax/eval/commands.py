@@ -1,0 +1,76 @@
+"""`leas evaluate`: the paper's experiments (Table II, Figs. 6-9) by one command."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from leas_jax.errors import UsageError
+from leas_jax.eval.scenarios import METHODS, SCENARIOS
+
+
+def _positive_int(name: str, allow_zero: bool = False):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} expects an integer, got {text!r}") from None
+        if value < 0 or (value == 0 and not allow_zero):
+            raise argparse.ArgumentTypeError(f"{name} expects an integer >= {0 if allow_zero else 1}, got {text!r}")
+        return value
+    return parse
+
+
+def cmd_evaluate(args) -> int:
+    from leas_jax.eval.evaluate import evaluate, parse_methods
+    from leas_jax.eval.tables import table_ii_markdown
+
+    if args.terrain is not None and args.scenario is not None:
+        raise UsageError("give either --scenario or --terrain, not both")
+    if args.terrain is None and args.scenario is None:
+        raise UsageError("one of --scenario or --terrain is required")
+    if args.terrain is not None and not Path(args.terrain).is_file():
+        raise UsageError(f"--terrain: no such file {args.terrain!r}")
+    scenarios = None
+    if args.scenario is not None:
+        scenarios = [s.strip() for s in args.scenario.split(",") if s.strip()]
+        unknown = [s for s in scenarios if s not in SCENARIOS + ("all",)]
+        if unknown or not scenarios:
+            raise UsageError(f"--scenario: unknown scenario {', '.join(unknown) or repr(args.scenario)} "
+                             f"(expected {'|'.join(SCENARIOS)}|all)")
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {args.out!r} exists and is not a directory")
+    report = evaluate(scenarios, parse_methods(args.methods), args.checkpoint, out, args.n_starts, args.workers,
+                      terrain_file=args.terrain, progress=not args.no_progress)
+    if report.get("table_ii"):
+        print(table_ii_markdown(report["table_ii"]))
+    for row in report["rows"]:
+        if row["cell"] == "all" or len(report["scenarios"][row["scenario"]]["cells"]) == 1:
+            print(f"{row['scenario']:12s} {row['method']:11s} n={row['n']:3d} coverage {row['coverage']:5.1f}% "
+                  f"success {row['success']:5.1f}%")
+    print(f"{report['seconds']:.1f} s -> {out}/results.json, table.md, table.csv, guides.npz, "
+          + ", ".join(report.get("figures", [])))
+    return 0
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "evaluate", help="baselines and LeaS on the paper's scenarios (Table II, Figs. 6-9)",
+        description="Draw seeded starts from each scenario's [scenario] table, build guide paths with each steering "
+                    "method, validate them with the contact generator in parallel and write results.json, table.md, "
+                    "table.csv, guides.npz and one PNG per scenario. `ground` runs Table II (3 yaw ranges x 3 "
+                    "initial speeds).")
+    parser.add_argument("--scenario", metavar="NAME", help=f"{'|'.join(SCENARIOS)}|all, or a comma-separated list")
+    parser.add_argument("--terrain", metavar="FILE", help="any terrain file with a [scenario] table (instead of "
+                                                          "--scenario)")
+    parser.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
+                                                          "(default: the paper's methods for each scenario)")
+    parser.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
+    parser.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
+                        help="starts per cell (default: the scenario table's n_starts, 60)")
+    parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
+                        help="contact-generator processes (default CPUs - 1; 0: in-process)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    parser.set_defaults(func=cmd_evaluate)

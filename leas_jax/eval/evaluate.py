@@ -1,0 +1,359 @@
+"""The paper's experiments: starts, guides per steering method, contact-plan validation, metrics.
+
+`evaluate(...)` runs scenarios end to end (host code; the guides of LeaS and
+the RRT's validity checks are jitted JAX):
+
+1. load the scenario's terrain, draw seeded starts per cell (`scenarios`);
+2. build one guide per start and method: RBLin, RBKino (through the
+   waypoints on the circuit), RBKino+RRT (one RRT per start, shared by
+   `rbkino_rrt` and `leas_rrt`), LeaS to the target (or along the waypoints),
+   LeaS along the RRT's waypoints;
+3. validate every guide with the contact generator in one worker pool per
+   terrain, with a progress bar;
+4. compute coverage and success per trajectory (`metrics`) and aggregate.
+
+A method that produces no guide for a start (the RRT found no path within
+its budget) counts as coverage 0, not a success, with error "rrt: no path";
+`leas_rrt` then has no waypoints to follow either, so both RRT methods are
+compared on the same planner output (paper Fig. 8).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import os
+import time
+from dataclasses import dataclass, field as dataclass_field
+from pathlib import Path
+
+import numpy as np
+
+from leas_jax.errors import UsageError
+from leas_jax.eval import metrics
+from leas_jax.eval.scenarios import (DEFAULT_METHODS, LEAS_METHODS, METHODS, RRT_METHODS, SCENARIOS, Cell, Starts,
+                                     cells_for, draw_starts, leas_horizon, route, scenario_file)
+
+
+@dataclass
+class Trajectory:
+    """One start, one method: its guide, the generator's answer, the metrics.
+
+    Attributes:
+        cell: index into the scenario's cells.
+        method: steering method name.
+        start: [4] (x, y, z, yaw) world.
+        speed: initial speed (m/s).
+        yaw_offset_deg: start yaw minus the direction to the first target (deg).
+        guide: [T, 4] world, or None when the method produced none.
+        waypoints: [W, 2] waypoints the method followed (RRT, circuit), or None.
+        outcome: `metrics.Outcome` once validated.
+    """
+
+    cell: int
+    method: str
+    start: np.ndarray
+    speed: float
+    yaw_offset_deg: float
+    guide: np.ndarray | None
+    waypoints: np.ndarray | None = None
+    outcome: metrics.Outcome | None = None
+    error: str | None = None
+
+
+@dataclass
+class ScenarioResult:
+    """All trajectories of one scenario, with its terrain and cells."""
+
+    name: str
+    terrain: object
+    cells: list[Cell]
+    methods: tuple[str, ...]
+    trajectories: list[Trajectory] = dataclass_field(default_factory=list)
+    seconds: dict = dataclass_field(default_factory=dict)
+
+    def summary(self) -> dict:
+        """{method: {cell name: metrics.summarize(...), "all": ...}}."""
+        table = {}
+        for method in self.methods:
+            rows = {}
+            for k, cell in enumerate(self.cells):
+                rows[cell.name] = metrics.summarize(t.outcome for t in self.trajectories
+                                                    if t.method == method and t.cell == k)
+            rows["all"] = metrics.summarize(t.outcome for t in self.trajectories if t.method == method)
+            table[method] = rows
+        return table
+
+
+def parse_methods(text: str | None) -> tuple[str, ...] | None:
+    """'rblin,leas' -> ('rblin', 'leas'); None stays None (each scenario's paper methods)."""
+    if text is None:
+        return None
+    names = tuple(dict.fromkeys(m.strip() for m in text.split(",") if m.strip()))
+    unknown = [m for m in names if m not in METHODS]
+    if not names or unknown:
+        raise UsageError(f"--methods: unknown method(s) {', '.join(unknown) or repr(text)} "
+                         f"(expected a comma-separated subset of {','.join(METHODS)})")
+    return names
+
+
+def _baseline_guides(method: str, field, starts: Starts, points: np.ndarray, config) -> list:
+    from leas_jax.steering.rbkino import rbkino, rbkino_through
+    from leas_jax.steering.rblin import rblin, rblin_through
+
+    single, through = (rblin, rblin_through) if method == "rblin" else (rbkino, rbkino_through)
+    guides = []
+    for pose, speed in zip(starts.poses, starts.speeds):
+        if len(points) == 1:
+            guides.append(single(field, pose, points[0], float(speed), config))
+        else:
+            guides.append(through(field, pose, points, float(speed), config))
+    return guides
+
+
+def _rrt_plans(field, terrain, starts: Starts, target, config, rrt_config, progress: bool) -> list:
+    from tqdm.auto import tqdm
+
+    from leas_jax.steering.rrt import plan_rrt
+
+    plans = []
+    for k, (pose, speed) in enumerate(tqdm(list(zip(starts.poses, starts.speeds)), desc="RBKino+RRT",
+                                           disable=not progress, leave=False)):
+        rrt = dataclasses.replace(rrt_config, seed=rrt_config.seed + k)
+        plans.append(plan_rrt(field, pose, target, float(speed), terrain.bounds, config, rrt))
+    return plans
+
+
+def _leas_guides(policy, field, starts: Starts, routes: list[np.ndarray], max_steps: int) -> list:
+    from leas_jax.steering.leas import rollout_batch
+
+    width = max(len(r) for r in routes)
+    # Pad every route to the same length by repeating its last point (rollout_batch's convention).
+    padded = np.stack([np.concatenate([r, np.repeat(r[-1:], width - len(r), axis=0)]) for r in routes])
+    result = rollout_batch(policy, field, starts.poses, padded, starts.speeds, max_steps=max_steps)
+    return [result.guide(n).astype(np.float64) for n in range(len(starts.poses))]
+
+
+def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, policy, n_starts: int,
+                       config, rrt_config, progress: bool = True) -> tuple[list[Trajectory], dict]:
+    """Starts and guides of every cell and method of one scenario (no validation yet).
+
+    Returns:
+        (trajectories, seconds spent per method building guides).
+    """
+    scenario = terrain.scenario
+    points = route(scenario)
+    target = np.asarray(scenario.target, np.float64)
+    trajectories, seconds = [], {m: 0.0 for m in methods}
+    for k, cell in enumerate(cells):
+        starts = draw_starts(scenario, cell, n_starts, scenario.seed + k, field, config.nominal_root_height)
+
+        def add(method, guides, waypoints=None, errors=None):
+            for n in range(len(starts.poses)):
+                trajectories.append(Trajectory(
+                    cell=k, method=method, start=starts.poses[n], speed=float(starts.speeds[n]),
+                    yaw_offset_deg=float(starts.yaw_offsets_deg[n]), guide=guides[n],
+                    waypoints=None if waypoints is None else waypoints[n],
+                    error=None if errors is None else errors[n]))
+
+        for method in ("rblin", "rbkino"):
+            if method in methods:
+                began = time.perf_counter()
+                add(method, _baseline_guides(method, field, starts, points, config),
+                    [points] * n_starts if len(points) > 1 else None)
+                seconds[method] += time.perf_counter() - began
+        plans = None
+        if any(m in methods for m in RRT_METHODS):
+            began = time.perf_counter()
+            plans = _rrt_plans(field, terrain, starts, target, config, rrt_config, progress)
+            seconds["rrt_search"] = seconds.get("rrt_search", 0.0) + time.perf_counter() - began
+        if "rbkino_rrt" in methods:
+            add("rbkino_rrt", [p.guide if p.success else None for p in plans],
+                [p.waypoints if p.success else None for p in plans],
+                [None if p.success else "rrt: no path" for p in plans])
+        horizon = policy.config.env.episode_length if policy is not None else 400
+        if "leas" in methods:
+            began = time.perf_counter()
+            steps = max(leas_horizon(p[:2], points, config.target_speed, config.timestep, horizon)
+                        for p in starts.poses)
+            add("leas", _leas_guides(policy, field, starts, [points] * n_starts, steps),
+                [points] * n_starts if len(points) > 1 else None)
+            seconds["leas"] += time.perf_counter() - began
+        if "leas_rrt" in methods:
+            began = time.perf_counter()
+            ok = [n for n, p in enumerate(plans) if p.success]
+            guides = [None] * n_starts
+            if ok:
+                sub = Starts(starts.poses[ok], starts.speeds[ok], starts.yaw_offsets_deg[ok])
+                routes = [plans[n].waypoints for n in ok]
+                steps = max(leas_horizon(starts.poses[n, :2], plans[n].waypoints, config.target_speed,
+                                         config.timestep, horizon) for n in ok)
+                for n, guide in zip(ok, _leas_guides(policy, field, sub, routes, steps)):
+                    guides[n] = guide
+            add("leas_rrt", guides, [p.waypoints if p.success else None for p in plans],
+                [None if p.success else "rrt: no path" for p in plans])
+            seconds["leas_rrt"] += time.perf_counter() - began
+    order = {m: i for i, m in enumerate(methods)}
+    trajectories.sort(key=lambda t: (t.cell, order[t.method]))
+    return trajectories, seconds
+
+
+def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: int, progress: bool = True,
+             desc: str = "contact planning") -> None:
+    """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`. Host-only."""
+    from tqdm.auto import tqdm
+
+    from leas_jax.contacts.pool import ValidationPool
+
+    target = np.asarray(terrain.scenario.target, np.float64)
+    todo = [t for t in trajectories if t.guide is not None and t.error is None]
+    for t in trajectories:
+        if t.guide is None or t.error is not None:
+            t.outcome = metrics.outcome(None, target, 0.0, -1, error=t.error or "no guide")
+    if not todo:
+        return
+    with ValidationPool(terrain, workers=workers, return_plans=True) as pool:
+        futures = {pool.submit([t.guide], timestep): t for t in todo}
+        with tqdm(total=len(todo), desc=desc, disable=not progress, leave=False) as bar:
+            for future in concurrent.futures.as_completed(futures):
+                t = futures[future]
+                (result,) = future.result()
+                t.outcome = metrics.outcome(t.guide, target, result.coverage, result.last_valid_index,
+                                            plan=result.plan, error=result.error)
+                bar.update(1)
+
+
+def default_workers() -> int:
+    """Worker processes for the contact generator: CPUs - 1, at least 1."""
+    return max(1, (os.cpu_count() or 2) - 1)
+
+
+def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, workers: int, config=None,
+                 rrt_config=None, progress: bool = True) -> ScenarioResult:
+    """Starts, guides, validation and metrics of one scenario.
+
+    Args:
+        name: scenario name (`ground` runs Table II's nine cells).
+        terrain: a `Terrain` with a `[scenario]` table.
+        methods: method names.
+        policy: a `Policy` (needed by leas and leas_rrt) or None.
+        n_starts: starts per cell (default the scenario table's n_starts).
+        workers: contact-generator processes (0: in-process).
+        config: `BaselineConfig` (default: from the policy's env, else the env defaults).
+        rrt_config: `RRTConfig` (the seed of start k is its seed + k).
+        progress: show progress bars.
+    """
+    from leas_jax.env import EnvConfig, heightfield_from_terrain
+    from leas_jax.steering.baselines import BaselineConfig
+    from leas_jax.steering.rrt import RRTConfig
+
+    if terrain.scenario is None:
+        raise UsageError(f"{terrain.path or terrain.name}: the terrain has no [scenario] table")
+    env = policy.config.env if policy is not None else EnvConfig()
+    config = config or BaselineConfig.from_env(env)
+    field = heightfield_from_terrain(terrain, env)
+    cells = cells_for(name, terrain.scenario)
+    n = int(n_starts or terrain.scenario.n_starts)
+    result = ScenarioResult(name, terrain, cells, tuple(methods))
+    result.trajectories, result.seconds = build_trajectories(
+        name, terrain, field, cells, methods, policy, n, config, rrt_config or RRTConfig(), progress)
+    began = time.perf_counter()
+    validate(terrain, result.trajectories, config.timestep, workers, progress, desc=f"{name}: contact planning")
+    result.seconds["contact_planning"] = time.perf_counter() - began
+    return result
+
+
+def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int | None = None,
+             workers: int | None = None, terrain_file=None, progress: bool = True, rrt_config=None,
+             figures: bool = True) -> dict:
+    """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
+
+    Args:
+        scenarios: names from SCENARIOS, or ["all"]; ignored when `terrain_file` is given.
+        methods: method names, or None for each scenario's paper methods.
+        checkpoint: run directory or policy.pkl (required by leas / leas_rrt).
+        out: output directory (None: write nothing).
+        n_starts: starts per cell (default each scenario table's).
+        workers: contact-generator processes (None: CPUs - 1; 0: in-process).
+        terrain_file: any terrain file with a [scenario] table, run as one scenario.
+        progress: progress bars.
+        rrt_config: `RRTConfig`.
+        figures: write PNG figures.
+
+    Returns:
+        the results dictionary written to results.json.
+    """
+    from leas_jax.eval import figures as figures_module
+    from leas_jax.eval import tables
+    from leas_jax.terrain import load_terrain
+
+    began = time.perf_counter()
+    if terrain_file is not None:
+        terrain = load_terrain(terrain_file)
+        if terrain.scenario is None:
+            raise UsageError(f"--terrain {terrain_file}: no [scenario] table (DESIGN §4)")
+        jobs = [(terrain.name, terrain)]
+    else:
+        names = list(SCENARIOS) if "all" in scenarios else list(dict.fromkeys(scenarios))
+        jobs = [(name, load_terrain(scenario_file(name))) for name in names]
+    wanted = {name: tuple(methods) if methods else DEFAULT_METHODS.get(name, ("rblin", "rbkino", "leas"))
+              for name, _ in jobs}
+    if n_starts is not None and n_starts < 1:
+        raise UsageError(f"--n-starts: expected a positive integer, got {n_starts}")
+    policy = None
+    if any(m in LEAS_METHODS for ms in wanted.values() for m in ms):
+        if checkpoint is None:
+            raise UsageError("--checkpoint is required by the methods leas and leas_rrt")
+        from leas_jax.training.policy import load_policy
+        policy = load_policy(checkpoint)
+    workers = default_workers() if workers is None else int(workers)
+    if workers < 0:
+        raise UsageError(f"--workers: expected an integer >= 0, got {workers}")
+    results = []
+    for name, terrain in jobs:
+        results.append(run_scenario(name, terrain, wanted[name], policy, n_starts, workers,
+                                    rrt_config=rrt_config, progress=progress))
+    report = tables.results_dict(results, policy=policy, seconds=time.perf_counter() - began)
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        tables.write_outputs(out, results, report)
+        if figures:
+            report["figures"] = [str(p.name) for p in figures_module.scenario_figures(results, out)]
+            tables.write_json(out / "results.json", report)
+    return report
+
+
+def checkpoint_policies(run_dir, limit: int | None = None) -> list:
+    """Deterministic policies of a run's saved training states (paper Fig. 4's learning progression).
+
+    Args:
+        run_dir: a `leas train` run directory (config.json, checkpoints/step_*.pkl).
+        limit: keep at most this many, evenly spread from first to last (None: all).
+
+    Returns:
+        list of `Policy`, oldest first; `env_steps` is the checkpoint's step count.
+    """
+    import json
+
+    from leas_jax.training.checkpoint import list_checkpoints, load_state
+    from leas_jax.training.config import TrainConfig
+    from leas_jax.training.policy import Policy
+
+    run_dir = Path(run_dir)
+    config_file = run_dir / "config.json"
+    if not config_file.is_file():
+        raise UsageError(f"{run_dir}: no config.json (give a `leas train` run directory)")
+    found = list_checkpoints(run_dir)
+    if not found:
+        raise UsageError(f"{run_dir}: no checkpoints/step_*.pkl")
+    if limit is not None and len(found) > limit:
+        picks = np.unique(np.round(np.linspace(0, len(found) - 1, limit)).astype(int))
+        found = [found[i] for i in picks]
+    config = TrainConfig.from_dict(json.loads(config_file.read_text()))
+    policies = []
+    for steps, path in found:
+        state = load_state(path)
+        policies.append(Policy(config=config, normalizer=state.normalizer, params=state.params.policy,
+                               env_steps=int(steps), source=str(path)))
+    return policies

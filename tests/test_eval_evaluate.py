@@ -1,0 +1,137 @@
+"""`leas evaluate` end to end on a small scenario with a tiny policy; metrics and CLI errors."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from leas_jax.cli import main
+from leas_jax.eval import metrics
+from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for
+from leas_jax.training import preset, train
+
+# 6 x 4 m floor, a wall across x = 3 from y = 0 to y = 2.6 (the RRT goes round it),
+# starts near (1, 1), target (5, 1).
+WALL_SCENARIO = """name = "wall_scenario"
+bounds = [[0.0, 0.0], [6.0, 4.0]]
+void_height = -2.0
+resolution = 0.05
+[[box]]
+center = [3.0, 2.0, -0.1]
+size = [6.0, 4.0, 0.2]
+[[box]]
+center = [3.0, 1.3, 0.75]
+size = [0.2, 2.6, 1.5]
+[scenario]
+target = [5.0, 1.0]
+start_region = [[0.9, 0.9], [1.1, 1.1]]
+start_yaw_deg = [-20.0, 20.0]
+start_speed = [0.0, 0.05]
+n_starts = 60
+seed = 0
+"""
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory):
+    """A tiny policy trained on the real arena (a few seconds)."""
+    out = tmp_path_factory.mktemp("run")
+    config = preset("smoke", num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8, num_minibatches=2,
+                    num_epochs=1, iterations_per_call=2)
+    train(config, out, progress=False)
+    return out
+
+
+def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
+    terrain = tmp_path / "wall.toml"
+    terrain.write_text(WALL_SCENARIO)
+    out = tmp_path / "eval"
+    code = main(["evaluate", "--terrain", str(terrain), "--methods", "rblin,rbkino,rbkino_rrt,leas,leas_rrt",
+                 "--checkpoint", str(run_dir), "--n-starts", "2", "--workers", "0", "--no-progress",
+                 "--out", str(out)])
+    assert code == 0
+    report = json.loads((out / "results.json").read_text())
+    scenario = report["scenarios"]["wall_scenario"]
+    trajectories = scenario["trajectories"]
+    assert len(trajectories) == 2 * 5
+    assert {t["method"] for t in trajectories} == {"rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt"}
+    guides = np.load(out / "guides.npz")
+    for k, t in enumerate(trajectories):
+        assert 0.0 <= t["coverage"] <= 1.0
+        if t["error"] is None:
+            guide = guides[f"wall_scenario/{k}"]
+            assert guide.shape == (t["guide_length"], 4)
+            # success needs the whole guide covered (DESIGN §8)
+            assert not t["success"] or t["last_valid_index"] == len(guide) - 1
+    # RBLin and RBKino drive straight into the wall: the plan cannot cover their guides.
+    for t in trajectories:
+        if t["method"] in ("rblin", "rbkino"):
+            assert t["coverage"] < 1.0 and not t["success"]
+        if t["method"] == "rbkino_rrt" and t["error"] is None:
+            assert t["waypoints"][-1] == [5.0, 1.0]
+    # the two starts share one seeded draw across methods
+    starts = {tuple(t["start"]) for t in trajectories}
+    assert len(starts) == 2
+    rows = list(csv.DictReader((out / "table.csv").open()))
+    assert {r["method"] for r in rows} == {"rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt"}
+    summary = scenario["summary"]["rblin"]["all"]
+    assert summary["coverage"] == pytest.approx(100 * np.mean([t["coverage"] for t in trajectories
+                                                               if t["method"] == "rblin"]), abs=1e-4)
+    assert "wall_scenario" in (out / "table.md").read_text()
+    assert (out / "wall_scenario.png").stat().st_size > 10_000
+    assert "coverage" in capsys.readouterr().out
+
+
+def test_outcome_success_needs_full_coverage_and_a_posture_near_target():
+    guide = np.column_stack([np.linspace(0, 4, 11), np.zeros(11), np.ones(11), np.zeros(11)])
+
+    class Plan:
+        q = np.array([[0.0, 0.0], [3.8, 0.1]])
+
+    full = metrics.outcome(guide, [4.0, 0.0], 1.0, 10, plan=Plan())
+    assert full.success and full.final_distance == pytest.approx(np.hypot(0.2, 0.1))
+    assert not metrics.outcome(guide, [4.0, 0.0], 0.9, 9, plan=Plan()).success  # not covered
+    assert not metrics.outcome(guide, [4.5, 0.0], 1.0, 10, plan=Plan()).success  # 0.71 m away
+    # without a plan the guide pose at the last valid index stands in
+    assert metrics.outcome(guide, [4.2, 0.0], 1.0, 10).success
+    failed = metrics.outcome(None, [4.0, 0.0], 0.0, -1, error="rrt: no path")
+    assert failed.coverage == 0.0 and not failed.success and failed.error == "rrt: no path"
+    assert metrics.summarize([full, failed]) == {"n": 2, "coverage": 50.0, "success": 50.0, "errors": 1}
+
+
+def test_ground_runs_table_ii_cells():
+    cells = cells_for("ground", None)
+    assert len(cells) == 9 and all(c.table_key in PAPER_TABLE_II for c in cells)
+    assert PAPER_TABLE_II[((150.0, 210.0), 0.01)] == {"rblin": 22.3, "rbkino": 76.5, "leas": 98.4}
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["evaluate", "--scenario", "moon", "--out", "o"], "unknown scenario moon"),
+    (["evaluate", "--scenario", "ground", "--methods", "rblin,teleport", "--out", "o"], "unknown method(s) teleport"),
+    (["evaluate", "--scenario", "ground", "--out", "o"], "--checkpoint is required"),
+    (["evaluate", "--out", "o"], "one of --scenario or --terrain"),
+    (["evaluate", "--scenario", "ground", "--terrain", "x.toml", "--out", "o"], "not both"),
+    (["evaluate", "--terrain", "missing.toml", "--out", "o"], "--terrain: no such file"),
+    (["evaluate", "--terrain", "terrains/training_arena.toml", "--methods", "rblin", "--out", "o"],
+     "no [scenario] table"),
+])
+def test_usage_errors_are_one_line(capsys, tmp_path, monkeypatch, argv, fragment):
+    from leas_jax.training.config import REPO_ROOT
+
+    monkeypatch.chdir(REPO_ROOT if "training_arena" in " ".join(argv) else tmp_path)
+    code = main(argv)
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and fragment in err, err
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["evaluate", "--scenario", "ground", "--n-starts", "0", "--out", "o"], "--n-starts expects an integer >= 1"),
+    (["evaluate", "--scenario", "ground", "--workers", "-1", "--out", "o"], "--workers expects an integer >= 0"),
+    (["evaluate", "--scenario", "ground"], "the following arguments are required: --out"),
+])
+def test_argument_errors_exit_2(capsys, argv, fragment):
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    err = capsys.readouterr().err.strip()
+    assert info.value.code == 2 and len(err.splitlines()) == 1 and fragment in err

@@ -207,12 +207,14 @@ class RobotCollision:
         import coal
 
         aabb = self.world_aabb(rot, pos) if aabb is None else aabb
-        a, b = self.self_pairs[:, 0], self.self_pairs[:, 1]
-        overlap = np.all((aabb[a, 0] <= aabb[b, 1]) & (aabb[a, 1] >= aabb[b, 0]), axis=1)
+        # Rows (min xyz, max xyz) gathered once per side of the pairs: two gathers instead of four.
+        flat = aabb.reshape(len(aabb), 6)
+        box_a, box_b = flat[self.self_pairs[:, 0]], flat[self.self_pairs[:, 1]]
+        overlap = np.all((box_a[:, :3] <= box_b[:, 3:]) & (box_a[:, 3:] >= box_b[:, :3]), axis=1)
         hits = []
         request = coal.CollisionRequest()
         result = coal.CollisionResult()
-        for ga, gb in self.self_pairs[overlap]:
+        for ga, gb in self.self_pairs[overlap].tolist():
             result.clear()
             if coal.collide(self.geometries[ga], coal.Transform3s(rot[ga], pos[ga]),
                             self.geometries[gb], coal.Transform3s(rot[gb], pos[gb]), request, result):

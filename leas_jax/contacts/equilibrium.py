@@ -185,12 +185,12 @@ def flat_support_margin(points: np.ndarray, normals: np.ndarray, com: np.ndarray
         Signed distance (m, > 0 inside) of com[:2] to the hull boundary, or -inf if a
         normal is not vertical or the hull is degenerate.
     """
-    if len(points) < 3 or np.any(normals[:, 2] < 1.0 - 1e-12):
+    if len(points) < 3 or normals[:, 2].min() < 1.0 - 1e-12:
         return -np.inf
     hull = convex_hull_2d(points[:, :2])
     if len(hull) < 3:
         return -np.inf
-    edges = np.roll(hull, -1, axis=0) - hull
+    edges = hull[np.arange(1, len(hull) + 1) % len(hull)] - hull  # np.roll(hull, -1, axis=0), cheaper
     rel = com[:2] - hull
     dist = (edges[:, 0] * rel[:, 1] - edges[:, 1] * rel[:, 0]) / np.hypot(edges[:, 0], edges[:, 1])
     return float(dist.min())

@@ -43,7 +43,7 @@ from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT,
                                      load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
 from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corners_world, sole_rotation,
-                                        surface_arrays, uncovered)
+                                        sole_rotation_single, surface_arrays, uncovered)
 from leas_jax.errors import UsageError
 
 
@@ -80,12 +80,15 @@ class GeneratorConfig:
 
 
 @dataclass
-class _Posture:
+class ContactPosture:
     """One key posture: configuration, feet (NaN row in the air), guide index."""
 
-    q: np.ndarray  # [39]
-    feet: np.ndarray  # [2, 7]
+    q: np.ndarray  # [39] Pinocchio configuration (root xyz + quaternion xyzw, joints)
+    feet: np.ndarray  # [2, 7] world sole placements (xyz + quaternion xyzw), NaN row in the air
     guide_index: int
+
+
+_Posture = ContactPosture  # the name the generator's code uses
 
 
 def _rotz(yaw: float) -> np.ndarray:
@@ -110,6 +113,8 @@ class ContactGenerator:
         config: generator settings.
     """
 
+    _SCREEN_CHUNK = 6  # pool candidates screened at once by _step (cost is mostly per call)
+
     def __init__(self, terrain, config: GeneratorConfig = GeneratorConfig()):
         self.terrain = terrain
         self.config = config
@@ -125,6 +130,8 @@ class ContactGenerator:
         self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
         self._nominal_xy = [tuple(row[:2].tolist()) for row in self._nominal]
         self._faces = {}  # face index -> (inward edge normals [E, 3], offsets [E])
+        # Diagnostics: postures built, candidates that passed the cover and reach tests
+        # (those screened: `_step` screens its candidates lazily).
         self.stats = {"postures_tried": 0, "candidates": 0}
 
     # ------------------------------------------------------------------ postures
@@ -270,6 +277,18 @@ class ContactGenerator:
             and `candidate_slab` vertically, dropped vertically on the face; the 4 x max_candidates closest
             that pass the polygon and overlap tests go through the cover and reach tests.
         """
+        pos, rot = self._candidate_pool(side, guide_pose, target_pos, target_yaw, avoid)
+        keep = self._screen(side, guide_pose, pos, rot)
+        return pos[keep], rot[keep]
+
+    def _candidate_pool(self, side: int, guide_pose, target_pos, target_yaw: float, avoid=None):
+        """The ranked placements of `candidates` before the cover and reach tests.
+
+        Returns:
+            (pos [M, 3], rot [M, 3, 3]), M <= 4 x max_candidates, world, in rank order.
+            Each passes or fails `_screen` on its own, so screening a prefix of this
+            list gives a prefix of `candidates` (what lets `_step` screen lazily).
+        """
         cfg = self.config
         surfaces = self.surfaces
         db = self.databases[side]
@@ -291,7 +310,7 @@ class ContactGenerator:
             # Database samples in a vertical column about the target, dropped vertically
             # on the face (reachability is re-checked exactly by IK below).
             world[:, 2] = (surfaces.offsets[s] - world[:, :2] @ normal[:2]) / normal[2]
-            rot = sole_rotation(normal[None], target_yaw)[0]
+            rot = sole_rotation_single(normal, target_yaw)
             inside = self._inside_face(s, world, rot)
             points.append(world[inside])
             owner.append(np.full(int(inside.sum()), s))
@@ -315,22 +334,32 @@ class ContactGenerator:
             ok = ~self._overlaps(pos, rot, *avoid)
         # The closest few go through the costlier tests.
         ok[np.cumsum(ok) > 4 * cfg.max_candidates] = False
-        pos, rot = pos[ok], rot[ok]
+        return pos[ok], rot[ok]
+
+    def _screen(self, side: int, guide_pose, pos, rot) -> np.ndarray:
+        """[N] the cover and reach tests of `candidates` on placements pos [N, 3], rot [N, 3, 3]:
+        nothing of the terrain over the sole, and reachable within the joint limits from
+        the guide root or the lowest allowed root. Each entry depends on its row only."""
+        cfg = self.config
         if len(pos) == 0:
-            return empty
+            return np.zeros(0, dtype=bool)
+        root_R = _rotz(guide_pose[3])
+        root_p = np.asarray(guide_pose[:3], dtype=np.float64)
         corners = sole_corners_world(pos, rot)
         probe = np.concatenate([corners, pos[:, None, :]], axis=1).reshape(-1, 3)
         free = np.all(uncovered(self.terrain, probe, cfg.cover_tol).reshape(-1, 5), axis=1)
         pos, rot = pos[free], rot[free]
-        # Reachable within the joint limits from the guide root or the lowest allowed root.
         leg = self.talos.legs[side]
-        reachable = np.zeros(len(pos), dtype=bool)
         local_rot = np.einsum("ji,njk->nik", root_R, rot)
-        for dz in (0.0, cfg.max_root_offset_z):
-            q, within = leg_ik(leg, local_rot, (pos - (root_p - np.array([0.0, 0.0, dz]))) @ root_R)
-            reachable |= within & np.all((q >= leg.lower) & (q <= leg.upper), axis=1)
+        # Both root heights (guide, lowest allowed) in one call: leg_ik is row-wise.
+        local_pos = [(pos - (root_p - np.array([0.0, 0.0, dz]))) @ root_R for dz in (0.0, cfg.max_root_offset_z)]
+        q, within = leg_ik(leg, np.concatenate([local_rot, local_rot]), np.concatenate(local_pos))
+        ok = within & np.all((q >= leg.lower) & (q <= leg.upper), axis=1)
+        reachable = ok[:len(pos)] | ok[len(pos):]
         self.stats["candidates"] += int(reachable.sum())
-        return pos[reachable], rot[reachable]
+        keep = np.zeros(len(free), dtype=bool)
+        keep[np.nonzero(free)[0][reachable]] = True
+        return keep
 
     def _inside_face(self, s: int, centres: np.ndarray, rot: np.ndarray) -> np.ndarray:
         """[N] whether soles with centres [N, 3] on face s and orientation rot [3, 3] lie
@@ -357,18 +386,20 @@ class ContactGenerator:
         Separating-axis test of the rectangles projected on the horizontal plane, grown
         by feet_gap / 2 each.
         """
-        half = np.array([SOLE_LENGTH / 2, SOLE_WIDTH / 2]) + self.config.feet_gap / 2
-        axes_a = rot[:, :2, :2]  # columns: sole x, y projected
-        axes_b = np.broadcast_to(other_rot[:2, :2], axes_a.shape)
-        delta = other_pos[:2] - pos[:, :2]
+        hx, hy = SOLE_LENGTH / 2 + self.config.feet_gap / 2, SOLE_WIDTH / 2 + self.config.feet_gap / 2
+        # Columns of the projected axes as [N] arrays (a: candidates, b: the other sole);
+        # written out component by component: the einsum form cost ~0.2 ms per call.
+        ax0, ay0, ax1, ay1 = rot[:, 0, 0], rot[:, 1, 0], rot[:, 0, 1], rot[:, 1, 1]
+        bx0, by0, bx1, by1 = (np.full(len(pos), float(v)) for v in
+                              (other_rot[0, 0], other_rot[1, 0], other_rot[0, 1], other_rot[1, 1]))
+        dx, dy = other_pos[0] - pos[:, 0], other_pos[1] - pos[:, 1]
         separated = np.zeros(len(pos), dtype=bool)
-        for axes in (axes_a, axes_b):
-            for k in range(2):
-                axis = axes[:, :, k]
-                axis = axis / np.linalg.norm(axis, axis=1, keepdims=True)
-                ra = np.abs(np.einsum("ni,nij->nj", axis, axes_a)) @ half
-                rb = np.abs(np.einsum("ni,nij->nj", axis, axes_b)) @ half
-                separated |= np.abs(np.einsum("ni,ni->n", axis, delta)) > ra + rb
+        for ux, uy in ((ax0, ay0), (ax1, ay1), (bx0, by0), (bx1, by1)):
+            norm = np.sqrt(ux * ux + uy * uy)
+            ux, uy = ux / norm, uy / norm
+            ra = np.abs(ux * ax0 + uy * ay0) * hx + np.abs(ux * ax1 + uy * ay1) * hy
+            rb = np.abs(ux * bx0 + uy * by0) * hx + np.abs(ux * bx1 + uy * by1) * hy
+            separated |= np.abs(ux * dx + uy * dy) > ra + rb
         return ~separated
 
     # ------------------------------------------------------------------ walking
@@ -410,16 +441,44 @@ class ContactGenerator:
             return None
         ahead = guide[min(index + int(round(cfg.lookahead / timestep)), len(guide) - 1)]
         target_pos, target_yaw = self._nominal_placement(ahead, side)
-        pos, rot = self.candidates(side, pose, target_pos, target_yaw, avoid=feet[other])
-        for k in range(min(len(pos), cfg.max_candidates)):
-            contacts = [stance, (side, pos[k], rot[k])]
-            if not self._comfortable(pose, contacts[1:]):
-                continue
-            double = self._posture(pose, index, contacts)
-            if double is not None:
-                feet[side] = (pos[k], rot[k])
-                return [single, double]
+        # Same candidates, in the same order, as `candidates(...)[:max_candidates]`, but
+        # screened a few at a time: the first or second usually gives a posture, and
+        # screening all 4 x max_candidates of the pool was a quarter of a plan's time.
+        pool_pos, pool_rot = self._candidate_pool(side, pose, target_pos, target_yaw, avoid=feet[other])
+        tried = 0
+        for start in range(0, len(pool_pos), self._SCREEN_CHUNK):
+            chunk = slice(start, start + self._SCREEN_CHUNK)
+            keep = self._screen(side, pose, pool_pos[chunk], pool_rot[chunk])
+            for pos, rot in zip(pool_pos[chunk][keep], pool_rot[chunk][keep]):
+                if tried == cfg.max_candidates:
+                    return None
+                tried += 1
+                contacts = [stance, (side, pos, rot)]
+                if not self._comfortable(pose, contacts[1:]):
+                    continue
+                double = self._posture(pose, index, contacts)
+                if double is not None:
+                    feet[side] = (pos, rot)
+                    return [single, double]
         return None
+
+    def double_support(self, pose) -> ContactPosture | None:
+        """The first posture of a plan whose guide starts at `pose`, or None.
+
+        Host-only, not jittable. Both soles at their half-sitting places under the pose,
+        moved onto support surfaces (best candidate each), then every check of a
+        posture: leg IK and joint limits, equilibrium, terrain and self collision, with
+        the root allowed its usual offsets (`max_root_offset_xy`, `max_root_offset_z`).
+
+        Args:
+            pose: [4] root pose (x, y, z, yaw), world frame, z = base_link height.
+
+        Returns:
+            the double-support posture (guide_index 0), or None where the generator
+            cannot stand there.
+        """
+        start = self._initial(np.asarray(pose, dtype=np.float64).reshape(1, 4))
+        return None if start is None else start[1]
 
     def _initial(self, guide) -> tuple[list, _Posture] | None:
         """Initial stance at guide pose 0: feet at their nominal places moved onto faces."""
@@ -538,12 +597,34 @@ def plan_contacts(terrain, guide, timestep: float, config: GeneratorConfig = Gen
     Returns:
         ContactPlan.
     """
+    return _generator(terrain, config).plan(guide, timestep)
+
+
+def _generator(terrain, config: GeneratorConfig) -> ContactGenerator:
+    """The process's ContactGenerator for (terrain object, config): the latest one is kept."""
     key = (id(terrain), config)
     generator = _GENERATORS.get("latest")
     if generator is None or generator[0] != key or generator[1].terrain is not terrain:
         generator = (key, ContactGenerator(terrain, config))
         _GENERATORS["latest"] = generator
-    return generator[1].plan(guide, timestep)
+    return generator[1]
 
 
-__all__ = ["ContactGenerator", "GeneratorConfig", "NOMINAL_ROOT_HEIGHT", "plan_contacts"]
+def double_support_posture(terrain, pose, config: GeneratorConfig = GeneratorConfig()) -> ContactPosture | None:
+    """Balanced, collision-free double-support posture of Talos at a root pose, or None.
+
+    Host-only, not jittable. What the generator does for the first posture of a plan
+    (`ContactGenerator.double_support`); the ground truth the reachability condition
+    is calibrated against (benchmarks/reachability_calibration.py). Reuses the
+    process's generator like `plan_contacts`.
+
+    Args:
+        terrain: a leas_jax.terrain.Terrain.
+        pose: [4] root pose (x, y, z, yaw), world frame, z = base_link height.
+        config: generator settings.
+    """
+    return _generator(terrain, config).double_support(pose)
+
+
+__all__ = ["ContactGenerator", "ContactPosture", "GeneratorConfig", "NOMINAL_ROOT_HEIGHT", "double_support_posture",
+           "plan_contacts"]

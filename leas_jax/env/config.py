@@ -14,17 +14,28 @@ import math
 class ReachabilityConfig:
     """Cylinders of the reachability condition, root frame (origin at base_link, z up, yaw only).
 
-    Defaults from DESIGN.md §5: the `talos_trunk` and `talos_*leg_rom` volumes of
-    the HPP Talos data, approximated by vertical cylinders.
+    DESIGN.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
+    Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]: sensitivity
+    68.4 %, specificity 77.1 %). The defaults below are calibrated by
+    benchmarks/reachability_calibration.py: sensitivity 94.9 %, specificity 73.6 % on
+    12000 poses of terrains/training_arena.toml against the contact generator's
+    double-support posture (no cylinder setting reaches 90 % specificity at 95 %
+    sensitivity there; the sensitivity target came first).
     """
 
-    trunk_radius: float = 0.30  # m, trunk cylinder radius (talos_trunk boxes span x ±0.2, y ±0.3)
-    trunk_bottom: float = -0.63  # m below the root: hip
-    trunk_top: float = 0.60  # m above the root: head
-    leg_radius: float = 0.25  # m, radius of each leg reachability cylinder (talos_*leg_rom)
+    # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)
+    trunk_radius: float = 0.35
+    # m below the root: calibrated (DESIGN §5: -0.63, the hip); the generator crouches to ~0.53 m
+    trunk_bottom: float = -0.525
+    trunk_top: float = 0.60  # m above the root: head (no effect on a heightfield, which has no overhangs)
+    # m, radius of each leg cylinder: calibrated (DESIGN §5: 0.25, talos_*leg_rom); the generator
+    # needs ground near the nominal sole place, so a wide disk over-accepts
+    leg_radius: float = 0.05
     leg_lateral_offset: float = 0.085  # m, leg cylinder centres at (0, ±offset) in the root frame
-    leg_bottom: float = -1.06  # m below the root: lowest reachable sole height
-    leg_top: float = -0.54  # m below the root: highest reachable sole height
+    # m below the root: lowest reachable sole height, calibrated (DESIGN §5: -1.06); the generator
+    # stands up to ~1.18 m above the soles (root lowered by at most 0.10 m)
+    leg_bottom: float = -1.175
+    leg_top: float = -0.525  # m below the root: highest reachable sole height, calibrated (DESIGN §5: -0.54)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,445 @@
+"""Calibrate the reachability condition (DESIGN §5) against the contact generator.
+
+Ground truth: a root pose (x, y, z, yaw) is *feasible* when the contact generator
+finds a balanced, collision-free double-support posture there
+(`leas_jax.contacts.generator.double_support_posture`: what it does for the first
+posture of a plan, root offsets included). The condition is
+`leas_jax.env.reachability.valid` (jitted, vmapped) on the Heightfield of the
+terrain. Figures: sensitivity = P(condition | feasible), specificity =
+P(not condition | infeasible) (the contact-planner literature reports 97 % / 92.5 %).
+
+Poses (seeded) on `terrains/training_arena.toml`: x, y uniform over the arena (70 %)
+or near obstacles (30 %: grid points whose 0.35 m neighbourhood spans more than
+5 cm of height, away from the raster border, jittered), yaw uniform, z = reference height + the nominal root height
+(EnvConfig, 1.0 m) + an offset uniform in [-0.55, +0.35] m. The reference height is
+the highest terrain point within 0.15 m (the ground a foot would stand on, so that
+poses beside holes stand over the ground). The offset range is wider than +-0.3 m
+below the nominal so that it brackets both ends of the generator's flat-ground range
+(root 0.53 to 1.18 m above the soles).
+
+The ground truth is computed once (multiprocessing, `--workers` processes, one
+ContactGenerator each); a grid search then re-evaluates only the condition over the
+cylinder parameters. The condition only reads three rasters at three points per pose:
+trunk_max at the root, leg_max and leg_min at the two leg centres (rasters depend on
+the radii, the centres on leg_lateral_offset), so for each radius pair those values
+are sampled once (jitted) and the thresholds (trunk_bottom, leg_bottom, leg_top) are
+compared in NumPy. trunk_top plays no part: a heightfield has no overhang, so the
+trunk cylinder is free iff the terrain under it stays below its bottom. The old and
+the chosen defaults are also evaluated with `reachability.valid` itself on
+`heightfield_from_terrain(terrain, EnvConfig(reachability=cfg))`, and must agree.
+
+Selection: parameters that keep a root at 1.0 m and at NOMINAL_ROOT_HEIGHT (1.019 m)
+above flat ground valid with >= 2 cm margins (the environment's spawn logic needs it);
+among those with sensitivity >= 95 % and specificity >= 90 % on the fitting two
+thirds of the poses, the largest Youden index (sensitivity + specificity - 1); if none
+meets both, the best specificity among those with sensitivity >= 95 %; if none, the
+largest Youden index. Near-ties go to the closest to the old defaults. Figures are
+reported on the held-out third and on all poses. Writes results/reachability_calibration.json (and caches the ground truth in
+.cache/reachability_ground_truth.npz at the repository root, reused with --reuse).
+
+    python benchmarks/reachability_calibration.py [--poses 12000] [--workers 2] [--reuse]
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")  # the workers are the parallelism
+
+import argparse  # noqa: E402
+import dataclasses  # noqa: E402
+import itertools  # noqa: E402
+import multiprocessing  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+REPO = Path(__file__).resolve().parent.parent
+ARENA = REPO / "terrains" / "training_arena.toml"
+Z_OFFSETS = (-0.55, 0.35)  # m, root height offsets about the nominal
+NEAR_FRACTION = 0.3  # share of poses drawn near obstacles
+REFERENCE_RADIUS = 0.15  # m, reference ground: highest point within this radius
+FLAT_HEIGHTS = (1.0, 1.01927)  # m: EnvConfig.nominal_root_height and contacts.NOMINAL_ROOT_HEIGHT
+FLAT_MARGIN = 0.02  # m, margin those must keep from every threshold
+TARGET_SENSITIVITY = 0.95
+TARGET_SPECIFICITY = 0.90
+
+# Grid of the search (m). trunk_top is not searched: no effect on a heightfield.
+GRID = {
+    "trunk_radius": (0.15, 0.20, 0.25, 0.30, 0.35, 0.40),
+    "leg_radius": (0.05, 0.08, 0.10, 0.15, 0.20, 0.25, 0.30),
+    "trunk_bottom": tuple(np.round(np.arange(-0.40, -0.8001, -0.025), 3)),
+    "leg_bottom": tuple(np.round(np.arange(-1.05, -1.3001, -0.025), 3)),
+    "leg_top": tuple(np.round(np.arange(-0.40, -0.7001, -0.025), 3)),
+}
+
+
+# ------------------------------------------------------------------ poses
+
+def sample_poses(terrain, count: int, seed: int = 0, nominal: float = 1.0,
+                 near_fraction: float = NEAR_FRACTION, z_offsets=Z_OFFSETS) -> np.ndarray:
+    """Seeded root poses on a terrain (see the module docstring).
+
+    Args:
+        terrain: a leas_jax.terrain.Terrain.
+        count: number of poses.
+        seed: numpy default_rng seed.
+        nominal: nominal root height above the reference ground, m.
+
+    Returns:
+        [count, 4] (x, y, z, yaw), world frame.
+    """
+    from leas_jax.env.field import disk_filter
+
+    rng = np.random.default_rng(seed)
+    heights = terrain.raster()
+    res = terrain.resolution
+    (x0, y0), (x1, y1) = terrain.bounds
+    margin = 0.3  # m, keep the legs' disks on the raster
+    n_near = int(round(near_fraction * count))
+    xy = np.column_stack([rng.uniform(x0 + margin, x1 - margin, count - n_near),
+                          rng.uniform(y0 + margin, y1 - margin, count - n_near)])
+    if n_near:
+        spread = disk_filter(heights, 0.35 / res, "max", terrain.void_height) - \
+            disk_filter(heights, 0.35 / res, "min", terrain.void_height)
+        # Not the raster border, where the void outside makes every point look "near".
+        border = int(np.ceil((margin + 0.35) / res))
+        spread[:border], spread[-border:], spread[:, :border], spread[:, -border:] = 0, 0, 0, 0
+        ij = np.argwhere(spread > 0.05)
+        pick = ij[rng.integers(0, len(ij), n_near)] if len(ij) else np.zeros((n_near, 2), int)
+        near = terrain.bounds[0] + pick * res + rng.uniform(-res / 2, res / 2, (n_near, 2))
+        near = np.clip(near, [x0 + margin, y0 + margin], [x1 - margin, y1 - margin])
+        xy = np.concatenate([xy, near])
+    reference = disk_filter(heights, REFERENCE_RADIUS / res, "max", terrain.void_height)
+    ij = np.clip(np.round((xy - terrain.bounds[0]) / res).astype(int), 0, np.array(heights.shape) - 1)
+    z = reference[ij[:, 0], ij[:, 1]] + nominal + rng.uniform(*z_offsets, len(xy))
+    yaw = rng.uniform(-np.pi, np.pi, len(xy))
+    poses = np.column_stack([xy, z, yaw])
+    return poses[rng.permutation(len(poses))]
+
+
+# ------------------------------------------------------------------ ground truth
+
+_WORKER = {}
+
+
+def _init_worker(terrain_text: str) -> None:
+    from leas_jax.contacts.generator import ContactGenerator
+    from leas_jax.terrain import loads_terrain
+
+    _WORKER["generator"] = ContactGenerator(loads_terrain(terrain_text, source="<calibration>"))
+
+
+def _feasible_chunk(poses: np.ndarray) -> np.ndarray:
+    generator = _WORKER["generator"]
+    return np.array([generator.double_support(pose) is not None for pose in poses], dtype=bool)
+
+
+def ground_truth(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100) -> np.ndarray:
+    """[N] whether the contact generator stands at each pose [N, 4] (double support).
+
+    Host-only. workers <= 1 runs in this process; otherwise a `spawn` pool (JAX may
+    already hold threads here, which `fork` would copy half-initialised) with one
+    ContactGenerator per worker; results keep the order of `poses`.
+    """
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4)
+    chunks = [poses[k:k + chunk] for k in range(0, len(poses), chunk)]
+    if workers <= 1:
+        _init_worker(terrain.text)
+        parts = [_feasible_chunk(c) for c in chunks]
+    else:
+        ctx = multiprocessing.get_context("spawn")
+        with ctx.Pool(workers, initializer=_init_worker, initargs=(terrain.text,)) as pool:
+            parts = pool.map(_feasible_chunk, chunks)
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=bool)
+
+
+# ------------------------------------------------------------------ condition
+
+def condition(terrain, poses: np.ndarray, config) -> np.ndarray:
+    """[N] `reachability.valid` (jitted, vmapped) at poses [N, 4] with `config` (a ReachabilityConfig)."""
+    import jax
+    import jax.numpy as jnp
+
+    from leas_jax.env import EnvConfig, heightfield_from_terrain
+    from leas_jax.env import reachability
+
+    field = heightfield_from_terrain(terrain, EnvConfig(reachability=config))
+    valid = jax.jit(jax.vmap(lambda f, p: reachability.valid(f, p, config), in_axes=(None, 0)))
+    return np.asarray(valid(field, jnp.asarray(poses, dtype=jnp.float32)))
+
+
+def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: float,
+                   leg_lateral_offset: float) -> dict:
+    """What the condition reads, per pose, for one pair of radii (jitted, vmapped).
+
+    Returns:
+        dict of float32 arrays: z [N], trunk [N] (trunk_max at the root), leg_max and
+        leg_min [N, 2] (at the left and right leg centres).
+    """
+    import jax
+    import jax.numpy as jnp
+
+    from leas_jax.env import EnvConfig, ReachabilityConfig
+    from leas_jax.env.field import Heightfield, disk_filter, sample_nearest
+    from leas_jax.env.reachability import leg_centers
+
+    config = ReachabilityConfig(trunk_radius=trunk_radius, leg_radius=leg_radius,
+                                leg_lateral_offset=leg_lateral_offset)
+    heights = np.asarray(terrain.raster(), dtype=np.float32)
+    res, void = terrain.resolution, terrain.void_height
+    f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
+    # Same rasters as heightfield_from_raster, without its spawn points (the grid
+    # visits radii that heightfield_from_raster might refuse for lack of spawns).
+    field = Heightfield(heights=f32(heights), trunk_max=f32(disk_filter(heights, trunk_radius / res, "max", void)),
+                        leg_max=f32(disk_filter(heights, leg_radius / res, "max", void)),
+                        leg_min=f32(disk_filter(heights, leg_radius / res, "min", void)),
+                        origin=f32(terrain.bounds[0]), resolution=f32(res), void_height=f32(void),
+                        spawn_xy=f32(np.zeros((1, 2))), spawn_spacing=f32(0.1))
+
+    def one(f, pose):
+        legs = leg_centers(pose, config)
+        return (sample_nearest(f, f.trunk_max, pose[:2]), sample_nearest(f, f.leg_max, legs),
+                sample_nearest(f, f.leg_min, legs))
+
+    poses32 = jnp.asarray(poses, dtype=jnp.float32)
+    trunk, leg_max, leg_min = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
+    return {"z": np.asarray(poses32[:, 2]), "trunk": np.asarray(trunk), "leg_max": np.asarray(leg_max),
+            "leg_min": np.asarray(leg_min)}
+
+
+def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top) -> np.ndarray:
+    """The condition of `reachability.terms` from `raster_samples`, for many thresholds at once.
+
+    Args:
+        samples: raster_samples output (N poses).
+        trunk_bottom, leg_bottom, leg_top: [...] broadcastable threshold arrays, m.
+
+    Returns:
+        [..., N] bool (float32 arithmetic, as in the jitted condition).
+    """
+    z = samples["z"]
+    f = np.float32
+    tb, lb, lt = (np.asarray(v, dtype=f)[..., None] for v in (trunk_bottom, leg_bottom, leg_top))
+    trunk_free = samples["trunk"] < z + tb
+    touch = ((samples["leg_max"][:, 0] >= z + lb) & (samples["leg_min"][:, 0] <= z + lt) &
+             (samples["leg_max"][:, 1] >= z + lb) & (samples["leg_min"][:, 1] <= z + lt))
+    return trunk_free & touch
+
+
+def confusion(predicted: np.ndarray, truth: np.ndarray) -> dict:
+    """Confusion counts and rates of a condition against the ground truth ([..., N] bool each).
+
+    Returns:
+        dict: tp, fn, fp, tn (condition true/false among feasible/infeasible poses),
+        sensitivity tp / (tp + fn) and specificity tn / (tn + fp) (NaN when undefined),
+        as Python numbers for a single condition, arrays for a batch.
+    """
+    predicted = np.asarray(predicted, dtype=bool)
+    truth = np.asarray(truth, dtype=bool)
+    tp = np.sum(predicted & truth, axis=-1)
+    fn = np.sum(~predicted & truth, axis=-1)
+    fp = np.sum(predicted & ~truth, axis=-1)
+    tn = np.sum(~predicted & ~truth, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sensitivity = np.where(tp + fn > 0, tp / np.maximum(tp + fn, 1), np.nan)
+        specificity = np.where(tn + fp > 0, tn / np.maximum(tn + fp, 1), np.nan)
+    out = {"tp": tp, "fn": fn, "fp": fp, "tn": tn, "sensitivity": sensitivity, "specificity": specificity}
+    if np.ndim(tp) == 0:
+        out = {k: (int(v) if k in ("tp", "fn", "fp", "tn") else float(v)) for k, v in out.items()}
+    return out
+
+
+def flat_ground_ok(trunk_bottom, leg_bottom, leg_top, heights=FLAT_HEIGHTS, margin: float = FLAT_MARGIN):
+    """[...] whether roots at `heights` above flat ground stay valid with `margin` (m) to spare.
+
+    On flat ground at 0 with the root at h: trunk free iff 0 < h + trunk_bottom, legs
+    touch iff h + leg_bottom <= 0 <= h + leg_top.
+    """
+    lo, hi = min(heights), max(heights)
+    return ((np.asarray(trunk_bottom) + lo >= margin) & (np.asarray(leg_bottom) + hi <= -margin) &
+            (np.asarray(leg_top) + lo >= margin))
+
+
+# ------------------------------------------------------------------ search
+
+def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, base_config,
+                grid: dict = GRID) -> dict:
+    """Best cylinder parameters over `grid` (see the module docstring).
+
+    Args:
+        poses: [N, 4]; truth: [N] ground truth; fit: [N] bool, poses used for choosing.
+        base_config: ReachabilityConfig giving the unsearched fields and the tie-break origin.
+
+    Returns:
+        dict: config (the chosen ReachabilityConfig), met (targets met on the fitting
+        poses), candidates (number searched), fit_figures, table (best per radius pair).
+    """
+    tb, lb, lt = np.meshgrid(grid["trunk_bottom"], grid["leg_bottom"], grid["leg_top"], indexing="ij")
+    tb, lb, lt = tb.ravel(), lb.ravel(), lt.ravel()
+    allowed = flat_ground_ok(tb, lb, lt)
+    tb, lb, lt = tb[allowed], lb[allowed], lt[allowed]
+    best, table = None, []
+    base = np.array([base_config.trunk_radius, base_config.leg_radius, base_config.trunk_bottom,
+                     base_config.leg_bottom, base_config.leg_top])
+    for trunk_radius, leg_radius in itertools.product(grid["trunk_radius"], grid["leg_radius"]):
+        samples = raster_samples(terrain, poses[fit], trunk_radius, leg_radius, base_config.leg_lateral_offset)
+        figures = confusion(thresholds(samples, tb, lb, lt), truth[fit])
+        sens, spec = figures["sensitivity"], figures["specificity"]
+        youden = sens + spec - 1
+        sensitive = sens >= TARGET_SENSITIVITY
+        met = sensitive & (spec >= TARGET_SPECIFICITY)
+        score = np.round(np.where(met, youden, np.where(sensitive, spec, youden)), 4)
+        params = np.column_stack([np.full(len(tb), trunk_radius), np.full(len(tb), leg_radius), tb, lb, lt])
+        distance = np.abs(params - base).sum(axis=1)
+        # Rank: both targets met (then the best Youden index); else the sensitivity
+        # target met (then the best specificity: a false negative ends episodes the
+        # generator could have walked, for good, while a false positive is caught by
+        # the generator in the planner-in-the-loop mode); else the best Youden index.
+        # Scores are rounded so that near-ties go to the parameters closest to the old defaults.
+        key = np.lexsort((distance, -score, ~sensitive, ~met))
+        k = int(key[0])
+        row = {"trunk_radius": trunk_radius, "leg_radius": leg_radius, "trunk_bottom": float(tb[k]),
+               "leg_bottom": float(lb[k]), "leg_top": float(lt[k]), "met": bool(met[k]),
+               "sensitive": bool(sensitive[k]), "score": float(score[k]),
+               "sensitivity": float(sens[k]), "specificity": float(spec[k]), "youden": float(youden[k]),
+               "distance": float(distance[k])}
+        table.append(row)
+        rank = (not row["met"], not row["sensitive"], -row["score"], row["distance"])
+        if best is None or rank < best[0]:
+            best = (rank, row)
+    row = best[1]
+    config = dataclasses.replace(base_config, **{k: row[k] for k in
+                                                 ("trunk_radius", "leg_radius", "trunk_bottom", "leg_bottom",
+                                                  "leg_top")})
+    return {"config": config, "met": row["met"], "sensitive": row["sensitive"], "candidates": int(len(tb)) * len(table),
+            "fit_figures": {"sensitivity": row["sensitivity"], "specificity": row["specificity"]},
+            "table": table}
+
+
+def figures(terrain, poses, truth, config, fit) -> dict:
+    """Figures of one config with the jitted `reachability.valid`, on all / fit / held-out poses."""
+    predicted = condition(terrain, poses, config)
+    return {"all": confusion(predicted, truth), "fit": confusion(predicted[fit], truth[fit]),
+            "held_out": confusion(predicted[~fit], truth[~fit])}, predicted
+
+
+def breakdown(poses, truth, predicted, terrain, nominal: float = 1.0) -> list[dict]:
+    """Rates per band of root height above the reference ground (where the errors are)."""
+    from leas_jax.env.field import disk_filter
+
+    reference = disk_filter(terrain.raster(), REFERENCE_RADIUS / terrain.resolution, "max", terrain.void_height)
+    ij = np.clip(np.round((poses[:, :2] - terrain.bounds[0]) / terrain.resolution).astype(int), 0,
+                 np.array(reference.shape) - 1)
+    offset = poses[:, 2] - reference[ij[:, 0], ij[:, 1]] - nominal
+    rows = []
+    for lo in np.arange(Z_OFFSETS[0], Z_OFFSETS[1] - 1e-9, 0.1):
+        band = (offset >= lo) & (offset < lo + 0.1)
+        c = confusion(predicted[band], truth[band])
+        rows.append({"offset_from": round(float(lo), 2), "offset_to": round(float(lo + 0.1), 2),
+                     "poses": int(band.sum()), "feasible": int(truth[band].sum()), **c})
+    return rows
+
+
+def _fmt(c: dict) -> str:
+    return (f"sens {100 * c['sensitivity']:5.1f} %  spec {100 * c['specificity']:5.1f} %  "
+            f"tp {c['tp']:5d} fn {c['fn']:5d} fp {c['fp']:5d} tn {c['tn']:5d}")
+
+
+def main(argv=None) -> None:
+    from common import save
+    from leas_jax.env import ReachabilityConfig
+    from leas_jax.terrain import load_terrain
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--poses", type=int, default=12000)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--terrain", default=str(ARENA))
+    parser.add_argument("--reuse", action="store_true", help="reuse the cached ground truth if it matches")
+    parser.add_argument("--baseline", default=None,
+                        help="old defaults as 'trunk_radius,trunk_bottom,trunk_top,leg_radius,leg_bottom,leg_top' "
+                             "(default: DESIGN §5 values)")
+    args = parser.parse_args(argv)
+
+    terrain = load_terrain(args.terrain)
+    # DESIGN §5 values: the defaults before this calibration.
+    old = ReachabilityConfig(trunk_radius=0.30, trunk_bottom=-0.63, trunk_top=0.60, leg_radius=0.25,
+                             leg_lateral_offset=0.085, leg_bottom=-1.06, leg_top=-0.54)
+    if args.baseline:
+        tr, tb, tt, lr, lb, lt = map(float, args.baseline.split(","))
+        old = ReachabilityConfig(trunk_radius=tr, trunk_bottom=tb, trunk_top=tt, leg_radius=lr, leg_bottom=lb,
+                                 leg_top=lt)
+    poses = sample_poses(terrain, args.poses, args.seed)
+    cache = REPO / ".cache" / "reachability_ground_truth.npz"  # git-ignored
+    truth, gt_seconds = None, None
+    if args.reuse and cache.is_file():
+        with np.load(cache) as data:
+            if data["poses"].shape == poses.shape and np.array_equal(data["poses"], poses):
+                truth, gt_seconds = data["truth"], float(data["seconds"])
+                print(f"reused the ground truth of {cache}")
+    if truth is None:
+        start = time.perf_counter()
+        truth = ground_truth(terrain, poses, args.workers)
+        gt_seconds = time.perf_counter() - start
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(cache, poses=poses, truth=truth, seconds=gt_seconds)
+    print(f"ground truth: {len(poses)} poses, {int(truth.sum())} feasible, {gt_seconds:.0f} s "
+          f"with {args.workers} workers ({1e3 * gt_seconds * max(args.workers, 1) / len(poses):.1f} ms per pose "
+          f"per worker)")
+    fit = np.random.default_rng(args.seed + 1).random(len(poses)) < 2 / 3
+
+    start = time.perf_counter()
+    search = grid_search(terrain, poses, truth, fit, old)
+    search_seconds = time.perf_counter() - start
+    new = search["config"]
+    old_figures, old_pred = figures(terrain, poses, truth, old, fit)
+    new_figures, new_pred = figures(terrain, poses, truth, new, fit)
+    # The NumPy thresholds of the search must agree with the jitted condition.
+    samples = raster_samples(terrain, poses, new.trunk_radius, new.leg_radius, new.leg_lateral_offset)
+    mismatch = int(np.sum(thresholds(samples, new.trunk_bottom, new.leg_bottom, new.leg_top) != new_pred))
+
+    print(f"\ngrid search: {search['candidates']} candidates in {search_seconds:.1f} s; best per radius pair "
+          f"(fitting poses):")
+    print(f"{'trunk r':>7s} {'leg r':>5s} {'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} "
+          f"{'sens %':>6s} {'spec %':>6s} {'met':>4s}")
+    for row in search["table"]:
+        print(f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
+              f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {100 * row['sensitivity']:6.1f} "
+              f"{100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
+    print()
+    for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new", new, new_figures)):
+        print(f"{name}: trunk r {cfg.trunk_radius:.2f} [{cfg.trunk_bottom:+.3f}, {cfg.trunk_top:+.2f}], "
+              f"legs r {cfg.leg_radius:.2f} [{cfg.leg_bottom:+.3f}, {cfg.leg_top:+.3f}]")
+        for part in ("all", "fit", "held_out"):
+            print(f"  {part:9s} {_fmt(fig[part])}")
+    print(f"targets (sens >= {100 * TARGET_SENSITIVITY:.0f} %, spec >= {100 * TARGET_SPECIFICITY:.0f} %) "
+          f"{'met' if search['met'] else 'NOT met'} on the fitting poses (sensitivity target "
+          f"{'met' if search['sensitive'] else 'NOT met'}); jitted/NumPy mismatches: {mismatch}")
+
+    as_dict = lambda c: dataclasses.asdict(c)  # noqa: E731
+    save("reachability_calibration", {
+        "terrain": str(Path(args.terrain).resolve().relative_to(REPO)) if Path(args.terrain).resolve().is_relative_to(REPO)
+        else args.terrain,
+        "poses": len(poses), "feasible": int(truth.sum()), "seed": args.seed, "workers": args.workers,
+        "ground_truth_seconds": gt_seconds, "search_seconds": search_seconds,
+        "sampling": {"z_offsets_m": Z_OFFSETS, "near_obstacle_fraction": NEAR_FRACTION,
+                     "reference": f"highest terrain point within {REFERENCE_RADIUS} m", "nominal_m": 1.0},
+        "targets": {"sensitivity": TARGET_SENSITIVITY, "specificity": TARGET_SPECIFICITY},
+        "flat_ground_constraint": {"heights_m": FLAT_HEIGHTS, "margin_m": FLAT_MARGIN},
+        "grid": {k: list(map(float, v)) for k, v in GRID.items()}, "candidates": search["candidates"],
+        "targets_met_on_fit": search["met"], "sensitivity_target_met_on_fit": search["sensitive"], "chosen": as_dict(new), "old": as_dict(old),
+        "figures": {"old": old_figures, "new": new_figures},
+        "by_height_offset": {"old": breakdown(poses, truth, old_pred, terrain),
+                             "new": breakdown(poses, truth, new_pred, terrain)},
+        "best_per_radius_pair": search["table"], "jit_numpy_mismatches": mismatch,
+    })
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,141 @@
+"""Reachability calibration machinery (benchmarks/reachability_calibration.py) on obvious cases.
+
+A 6 x 6 m slab with a 1.5 m wall: roots at the nominal height over open ground are
+feasible for the contact generator and valid for the condition; roots far above the
+ground or inside the wall are neither. Checks the ground truth (in-process and with a
+2-process pool), the confusion counts, the NumPy threshold form of the condition
+against the jitted one, the flat-ground constraint and a tiny grid search.
+"""
+
+import dataclasses
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from leas_jax.contacts.generator import ContactPosture, double_support_posture
+from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT
+from leas_jax.env import ReachabilityConfig
+from leas_jax.terrain import loads_terrain
+
+# Imported by name from benchmarks/ (on sys.path, which spawned pool workers inherit) so
+# that the pool can pickle its functions.
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+import reachability_calibration as rc  # noqa: E402
+
+TERRAIN = loads_terrain("""name = "calibration_cases"
+bounds = [[0.0, 0.0], [6.0, 6.0]]
+void_height = -2.0
+resolution = 0.02
+[[box]]
+center = [3.0, 3.0, -0.1]
+size = [6.0, 6.0, 0.2]
+[[box]]
+center = [4.5, 3.0, 0.75]
+size = [0.4, 4.0, 1.5]
+""")  # wall: x 4.3-4.7, y 1-5, 1.5 m tall
+
+
+def _cases():
+    """[40, 4] poses and [40] expected truth: 16 standing, 12 too high, 12 inside the wall."""
+    rng = np.random.default_rng(3)
+    stand = np.column_stack([rng.uniform(1.0, 3.0, 16), rng.uniform(1.0, 5.0, 16),
+                             np.where(np.arange(16) % 2 == 0, 1.0, NOMINAL_ROOT_HEIGHT),
+                             rng.uniform(-math.pi, math.pi, 16)])
+    high = np.column_stack([rng.uniform(1.0, 3.0, 12), rng.uniform(1.0, 5.0, 12), np.full(12, 2.0),
+                            rng.uniform(-math.pi, math.pi, 12)])
+    wall = np.column_stack([rng.uniform(4.4, 4.6, 12), rng.uniform(1.5, 4.5, 12), np.full(12, 1.0),
+                            rng.uniform(-math.pi, math.pi, 12)])
+    return np.concatenate([stand, high, wall]), np.repeat([True, False, False], [16, 12, 12])
+
+
+POSES, EXPECTED = _cases()
+
+
+@pytest.fixture(scope="module")
+def truth():
+    return rc.ground_truth(TERRAIN, POSES, workers=1)
+
+
+def test_ground_truth_on_obvious_cases(truth):
+    np.testing.assert_array_equal(truth, EXPECTED)
+    posture = double_support_posture(TERRAIN, POSES[0])
+    assert isinstance(posture, ContactPosture) and posture.guide_index == 0
+    assert np.all(np.isfinite(posture.feet)) and posture.q.shape == (39,)
+    np.testing.assert_allclose(posture.feet[:, 2], 0.0, atol=1e-9)  # both soles on the slab
+    assert double_support_posture(TERRAIN, POSES[-1]) is None
+
+
+def test_ground_truth_pool_matches_in_process(truth):
+    # A few poses of each kind through 2 spawned workers, chunks of 3: same order.
+    pick = np.r_[0:5, 16:19, 28:31]
+    np.testing.assert_array_equal(rc.ground_truth(TERRAIN, POSES[pick], workers=2, chunk=3), truth[pick])
+
+
+def test_condition_on_obvious_cases_old_and_new_defaults():
+    old = ReachabilityConfig(trunk_radius=0.30, trunk_bottom=-0.63, trunk_top=0.60, leg_radius=0.25,
+                             leg_bottom=-1.06, leg_top=-0.54)
+    for config in (old, ReachabilityConfig()):
+        predicted = rc.condition(TERRAIN, POSES, config)
+        np.testing.assert_array_equal(predicted, EXPECTED)
+        # The search's NumPy form agrees with the jitted condition, on these poses and on
+        # the thresholds that flip them (the high roots become valid with a low enough leg_bottom).
+        samples = rc.raster_samples(TERRAIN, POSES, config.trunk_radius, config.leg_radius,
+                                    config.leg_lateral_offset)
+        np.testing.assert_array_equal(rc.thresholds(samples, config.trunk_bottom, config.leg_bottom, config.leg_top),
+                                      predicted)
+        low = dataclasses.replace(config, leg_bottom=-2.1)
+        np.testing.assert_array_equal(rc.thresholds(samples, low.trunk_bottom, low.leg_bottom, low.leg_top),
+                                      rc.condition(TERRAIN, POSES, low))
+        assert rc.condition(TERRAIN, POSES, low)[16:28].all()
+
+
+def test_confusion_counts_by_hand():
+    truth = np.array([1, 1, 1, 1, 0, 0, 0, 0, 0, 0], dtype=bool)
+    predicted = np.array([1, 1, 1, 0, 1, 0, 0, 0, 0, 0], dtype=bool)
+    c = rc.confusion(predicted, truth)
+    assert (c["tp"], c["fn"], c["fp"], c["tn"]) == (3, 1, 1, 5)
+    assert c["sensitivity"] == pytest.approx(0.75) and c["specificity"] == pytest.approx(5 / 6)
+    batch = rc.confusion(np.stack([predicted, truth, ~truth]), truth)  # [3, N]: rates per row
+    np.testing.assert_allclose(batch["sensitivity"], [0.75, 1.0, 0.0])
+    np.testing.assert_allclose(batch["specificity"], [5 / 6, 1.0, 0.0])
+    assert math.isnan(rc.confusion(predicted[4:], truth[4:])["sensitivity"])  # no feasible pose
+
+
+def test_flat_ground_constraint():
+    # Roots at 1.0 and 1.019 m above flat ground, 2 cm to spare on every threshold.
+    assert rc.flat_ground_ok(-0.50, -1.175, -0.525)
+    assert not rc.flat_ground_ok(-0.99, -1.175, -0.525)  # trunk bottom 1 cm above the ground
+    assert not rc.flat_ground_ok(-0.50, -1.03, -0.525)  # 1.019 m root: ground 1.1 cm inside the band
+    assert not rc.flat_ground_ok(-0.50, -1.175, -0.99)
+    cfg = ReachabilityConfig()
+    assert rc.flat_ground_ok(cfg.trunk_bottom, cfg.leg_bottom, cfg.leg_top)  # the defaults keep spawns valid
+
+
+def test_tiny_grid_search_separates_the_cases(truth):
+    grid = {"trunk_radius": (0.30,), "leg_radius": (0.05, 0.25), "trunk_bottom": (-0.5, -0.63),
+            "leg_bottom": (-1.175, -2.1), "leg_top": (-0.525,)}
+    fit = np.ones(len(POSES), dtype=bool)
+    result = rc.grid_search(TERRAIN, POSES, truth, fit, ReachabilityConfig(), grid)
+    assert result["met"] and result["candidates"] == 2 * 4
+    chosen = result["config"]
+    # leg_bottom -2.1 accepts the high roots (specificity 60 %): never chosen.
+    assert chosen.leg_bottom == -1.175
+    assert result["fit_figures"] == {"sensitivity": 1.0, "specificity": 1.0}
+
+
+def test_sample_poses_seeded_and_in_range():
+    poses = rc.sample_poses(TERRAIN, 200, seed=5)
+    np.testing.assert_array_equal(poses, rc.sample_poses(TERRAIN, 200, seed=5))
+    assert poses.shape == (200, 4)
+    assert np.all((poses[:, :2] >= 0.3) & (poses[:, :2] <= 5.7))
+    assert np.all(np.abs(poses[:, 3]) <= math.pi)
+    # z: reference ground (highest within 0.15 m: 0 on the slab, 1.5 near the wall) + 1.0 + offset.
+    on_slab = poses[:, 0] < 3.5
+    offsets = poses[on_slab, 2] - 1.0
+    assert offsets.min() >= rc.Z_OFFSETS[0] and offsets.max() <= rc.Z_OFFSETS[1]
+    # 30 % near the wall (the only obstacle): within 0.35 m + a cell of its footprint.
+    near = (poses[:, 0] > 4.3 - 0.37) & (poses[:, 0] < 4.7 + 0.37)
+    assert near.sum() >= 0.3 * 200

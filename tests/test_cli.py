@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from leas_jax.cli import main
-from leas_jax.train import preset, train
+from leas_jax.training import preset, train
 
 ARENA = "terrains/training_arena.toml"
 

@@ -9,8 +9,8 @@ import pytest
 
 from leas_jax.env import heightfield_from_raster
 from leas_jax.errors import LeasError, UsageError
-from leas_jax.train import TrainConfig, load_policy, preset, train
-from leas_jax.train import checkpoint
+from leas_jax.training import TrainConfig, load_policy, preset, train
+from leas_jax.training import checkpoint
 
 
 def tiny_config(**overrides):

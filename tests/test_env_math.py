@@ -20,8 +20,8 @@ def flat(size_m=10.0, height=0.0):
     return np.full((n, n), height, np.float32)
 
 
-def field_of(heights):
-    return heightfield_from_raster(heights, (0.0, 0.0), RES, -2.0, CFG)
+def field_of(heights, require_spawn=True):
+    return heightfield_from_raster(heights, (0.0, 0.0), RES, -2.0, CFG, require_spawn=require_spawn)
 
 
 def cell(x):
@@ -118,7 +118,7 @@ def test_heightmap_flat_step_and_clipping():
     # turned to face +y at y = 5.7: points ahead beyond y = 6.0 see the wall, clipped to -0.2
     hmap_wall = np.asarray(heightmap.sample(field, jnp.array([3.0, 5.7, 1.0, math.pi / 2]))).reshape(11, 7)
     assert hmap_wall[0, 3] == pytest.approx(-0.2)  # 0.72 m ahead: y = 6.42
-    void = field_of(np.full((11, 11), -2.0, np.float32))
+    void = field_of(np.full((11, 11), -2.0, np.float32), require_spawn=False)
     assert float(heightmap.sample(void, jnp.array([0.1, 0.1, 1.0, 0.0]))[0]) == pytest.approx(-1.4)
 
 
@@ -144,6 +144,8 @@ def scene():
     ("too high above the ground", pose(3.0, 2.0, 1.7), False),
     ("too low: trunk in the ground", pose(3.0, 2.0, 0.5), False),
     ("over the middle of a hole", pose(7.0, 2.0, 1.0), False),
+    ("sunk into the hole, 1 m above the void: the void is no floor", pose(7.0, 2.0, -1.0), False),
+    ("beyond the terrain border", pose(10.6, 5.0, 1.0), False),
     ("beside a wall, 0.2 m away", pose(1.4, 7.0, 1.0), False),
     ("0.5 m from the wall", pose(1.7, 7.0, 1.0), True),
     ("on the bridge, facing along it", pose(7.0, 7.0, 1.0, 0.0), True),

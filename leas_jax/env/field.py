@@ -27,8 +27,10 @@ class Heightfield:
     Attributes:
         heights: [nx, ny] terrain height (m).
         trunk_max: [nx, ny] highest terrain point within `trunk_radius` of the point.
-        leg_max: [nx, ny] highest terrain point within `leg_radius` of the point.
-        leg_min: [nx, ny] lowest terrain point within `leg_radius` of the point.
+        leg_max: [nx, ny] highest solid terrain point within `leg_radius` of the point
+            (-inf where there is only void).
+        leg_min: [nx, ny] lowest solid terrain point within `leg_radius` of the point
+            (+inf where there is only void).
         origin: [2] world (x, y) of `heights[0, 0]`.
         resolution: [] cell size (m).
         void_height: [] height outside the grid.
@@ -55,8 +57,9 @@ def _grid_index(field: Heightfield, xy: jax.Array):
     return u, v
 
 
-def sample_nearest(field: Heightfield, raster: jax.Array, xy: jax.Array) -> jax.Array:
-    """Value of `raster` at the grid point nearest to each world point; void outside.
+def sample_nearest(field: Heightfield, raster: jax.Array, xy: jax.Array, outside=None) -> jax.Array:
+    """Value of `raster` at the grid point nearest to each world point; `outside` (default: the
+    void height) beyond the grid.
 
     Args:
         field: the heightfield (for origin, resolution, void height).
@@ -72,7 +75,7 @@ def sample_nearest(field: Heightfield, raster: jax.Array, xy: jax.Array) -> jax.
     j = jnp.round(v).astype(jnp.int32)
     inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
     flat = raster.reshape(-1)[jnp.clip(i, 0, nx - 1) * ny + jnp.clip(j, 0, ny - 1)]
-    return jnp.where(inside, flat, field.void_height)
+    return jnp.where(inside, flat, field.void_height if outside is None else outside)
 
 
 def sample_bilinear(field: Heightfield, xy: jax.Array) -> jax.Array:
@@ -135,34 +138,39 @@ def disk_filter(heights: np.ndarray, radius_cells: float, reduce: str, cval: flo
     return out
 
 
-def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, leg_max: np.ndarray,
-                  leg_min: np.ndarray, resolution: float, config: EnvConfig,
-                  spacing: float) -> np.ndarray:
+def _solid(heights: np.ndarray, void_height: float, fill: float) -> np.ndarray:
+    """Heights with the void replaced by `fill`: the void is no floor a foot can touch."""
+    return np.where(heights > void_height + 1e-6, heights, fill)
+
+
+def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float, resolution: float,
+                  config: EnvConfig, spacing: float) -> np.ndarray:
     """Grid indices [S, 2] where a root at nominal height is valid for every yaw.
 
     The leg cylinders turn with the yaw around the root; a point is kept when a
-    cylinder of radius (leg_radius - lateral offset) around it already reaches
-    the ground, which holds for both legs whatever the yaw. (Host, NumPy.)
+    cylinder of radius max(leg_radius - lateral offset, one cell) around it
+    reaches solid ground within the leg band, which then holds for both legs
+    whatever the yaw, and when the point itself is solid ground. (Host, NumPy.)
     """
     reach = config.reachability
     stride = max(int(round(spacing / resolution)), 1)
     z = heights + config.nominal_root_height
     inner = max(reach.leg_radius - reach.leg_lateral_offset, resolution) / resolution
-    inner_max = disk_filter(heights, inner, "max", -np.inf)
-    inner_min = disk_filter(heights, inner, "min", np.inf)
-    ok = (trunk_max < z + reach.trunk_bottom)
+    inner_max = disk_filter(_solid(heights, void_height, -np.inf), inner, "max", -np.inf)
+    inner_min = disk_filter(_solid(heights, void_height, np.inf), inner, "min", np.inf)
+    ok = (trunk_max < z + reach.trunk_bottom) & (heights > void_height + 1e-6)
     ok &= (inner_max >= z + reach.leg_bottom) & (inner_min <= z + reach.leg_top)
     # keep away from the grid border so that jittered resets stay inside
     ok[:stride, :] = ok[-stride:, :] = False
     ok[:, :stride] = ok[:, -stride:] = False
     sub = np.zeros_like(ok)
     sub[::stride, ::stride] = True
-    del leg_max, leg_min  # the inner disk test above implies the per-leg test
     return np.argwhere(ok & sub)
 
 
 def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void_height: float,
-                            config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10) -> Heightfield:
+                            config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10,
+                            require_spawn: bool = True) -> Heightfield:
     """Build the JAX heightfield and its reachability rasters (host only, not jittable).
 
     Args:
@@ -172,15 +180,21 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
         void_height: height outside the grid (m).
         config: environment configuration (cylinder radii, nominal root height).
         spawn_spacing: spacing of reset candidates (m).
+        require_spawn: raise ValueError when no point is valid for a reset; with
+            False the grid centre stands in (for fields used only for sampling).
     """
     heights = np.asarray(heights, dtype=np.float32)
     reach: ReachabilityConfig = config.reachability
     trunk_max = disk_filter(heights, reach.trunk_radius / resolution, "max", void_height)
-    leg_max = disk_filter(heights, reach.leg_radius / resolution, "max", void_height)
-    leg_min = disk_filter(heights, reach.leg_radius / resolution, "min", void_height)
-    spawn_ij = _spawn_points(heights, trunk_max, leg_max, leg_min, resolution, config, spawn_spacing)
+    # legs touch solid terrain only: the void is ignored (-inf for the max, +inf for the min),
+    # so a disk over the void alone never touches, whatever the root height
+    leg_max = disk_filter(_solid(heights, void_height, -np.inf), reach.leg_radius / resolution, "max", -np.inf)
+    leg_min = disk_filter(_solid(heights, void_height, np.inf), reach.leg_radius / resolution, "min", np.inf)
+    spawn_ij = _spawn_points(heights, trunk_max, void_height, resolution, config, spawn_spacing)
     if len(spawn_ij) == 0:
-        raise ValueError("the terrain has no valid spawn position for the root at nominal height")
+        if require_spawn:
+            raise ValueError("the terrain has no valid spawn position for the root at nominal height")
+        spawn_ij = np.array([[heights.shape[0] // 2, heights.shape[1] // 2]])
     spawn_xy = np.asarray(origin, dtype=np.float32) + spawn_ij.astype(np.float32) * resolution
     f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
     return Heightfield(

@@ -7,12 +7,13 @@ A pose is valid when
     within the radius is below z + trunk_bottom;
   - both legs touch: for each leg, the vertical cylinder of radius `leg_radius`
     centred at (0, ±leg_lateral_offset) in the root frame, spanning
-    [z + leg_bottom, z + leg_top], contains terrain surface. We test that the
-    band intersects [lowest, highest] terrain height within the disk. This is
-    exact when the heights inside the disk are connected and over-accepts only
-    when a vertical jump taller than the band (0.52 m) skips it entirely,
-    e.g. a leg disk straddling a tall wall; the trunk test rejects most such
-    poses.
+    [z + leg_bottom, z + leg_top], contains solid terrain surface (the void
+    under holes is no floor). We test that the band intersects
+    [lowest, highest] solid terrain height within the disk. This is exact
+    when the heights inside the disk are connected and over-accepts only when
+    a vertical jump taller than the band (leg_top - leg_bottom) skips it
+    entirely, e.g. a leg disk straddling a tall wall; the trunk test rejects
+    most such poses.
 Disk maxima and minima are precomputed rasters (`Heightfield`), so the test
 costs three gathers per leg pair.
 """
@@ -44,8 +45,8 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
     z = pose[2]
     trunk_free = sample_nearest(field, field.trunk_max, pose[:2]) < z + config.trunk_bottom
     legs = leg_centers(pose, config)
-    highest = sample_nearest(field, field.leg_max, legs)
-    lowest = sample_nearest(field, field.leg_min, legs)
+    highest = sample_nearest(field, field.leg_max, legs, outside=-jnp.inf)
+    lowest = sample_nearest(field, field.leg_min, legs, outside=jnp.inf)
     touch = (highest >= z + config.leg_bottom) & (lowest <= z + config.leg_top)
     return {"trunk_free": trunk_free, "left_touch": touch[0], "right_touch": touch[1]}
 

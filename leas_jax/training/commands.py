@@ -23,6 +23,16 @@ def _add_training_arguments(parser) -> None:
 
     parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
                         help="smoke (< 1 min), quick (~10 min on 2 cores), paper (80 M steps)")
+    parser.add_argument("--mode", default="geometric", choices=["geometric", "planner"],
+                        help="geometric: reachability condition only; planner: every episode validated by the "
+                             "Talos contact generator (the paper's method)")
+    parser.add_argument("--init", metavar="RUN_DIR", default=None,
+                        help="planner mode: fine-tune from this geometric run's latest checkpoint")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="planner mode: contact-generator worker processes (default: one per CPU minus one, "
+                             "at least 1; 0 plans in this process)")
+    parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
+                        help="planner mode: validate on this cluster instead of local processes")
     parser.add_argument("--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)")
     parser.add_argument("--seed", type=int, default=None, help="PRNG seed (default: the preset's, 0)")
     parser.add_argument("--terrain", metavar="FILE", default=None,
@@ -37,6 +47,14 @@ def config_from_args(args):
     from leas_jax.training.config import preset
 
     overrides = {}
+    if args.init is not None:
+        if args.mode != "planner":
+            raise UsageError("--init is for --mode planner (fine-tuning a geometric policy)")
+        if not (Path(args.init) / "checkpoints").is_dir():
+            raise UsageError(f"--init: {args.init} holds no checkpoints/ (give a `leas train` run directory)")
+        overrides["init_from"] = str(args.init)
+    if args.workers is not None and args.workers < 0:
+        raise UsageError(f"--workers must be >= 0, got {args.workers}")
     if args.seed is not None:
         overrides["seed"] = args.seed
     if args.terrain is not None:
@@ -47,14 +65,14 @@ def config_from_args(args):
         overrides["num_timesteps"] = args.timesteps
     if args.num_envs is not None:
         overrides["num_envs"] = args.num_envs
-    return preset(args.preset, **overrides)
+    return preset(args.preset, mode=args.mode, **overrides)
 
 
 def cmd_train(args) -> int:
     from leas_jax.training.loop import train
 
     config = config_from_args(args)
-    result = train(config, args.out, progress=not args.no_progress)
+    result = train(config, args.out, progress=not args.no_progress, workers=args.workers, address=args.ray_address)
     metrics = result.metrics
     print(f"trained {result.env_steps:,} env steps in {result.wall_s:.0f} s "
           f"({metrics.get('sps', float('nan')):,.0f} steps/s); policy: {result.policy_path}")

@@ -47,13 +47,21 @@ class TrainConfig:
     """PPO training configuration (geometric mode). Defaults: the `quick` preset."""
 
     preset: str = "quick"
+    # "geometric": PPO on the reachability condition alone; "planner": the paper's
+    # method, every episode validated by the Talos contact generator (planner.py).
+    mode: str = "geometric"
+    # planner mode: start from this geometric run's latest checkpoint ("" = scratch)
+    init_from: str = ""
     terrain: str = "terrains/training_arena.toml"  # training terrain file
     num_timesteps: int = 60_000_000  # env steps in total
     num_envs: int = 2048
     unroll_length: int = 16  # steps per env per iteration
     num_minibatches: int = 16  # per epoch (paper: 256 of a smaller batch, see module doc)
     num_epochs: int = 10  # passes over each batch, paper Table I (noptepochs)
-    learning_rate: float = 5e-4  # paper Table I
+    learning_rate: float = 5e-4  # paper Table I (initial value)
+    # Stable Baselines' PPO1, which the paper modified, anneals the learning rate
+    # linearly to zero by default (schedule='linear'); "constant" keeps it.
+    learning_rate_schedule: str = "linear"
     discounting: float = 0.97  # paper Table I
     gae_lambda: float = 0.95  # Stable Baselines PPO2 default
     clipping_epsilon: float = 0.2  # paper Table I
@@ -80,6 +88,7 @@ class TrainConfig:
 
     @property
     def num_iterations(self) -> int:
+        """Geometric mode: iterations of the run (planner mode stops on env steps instead)."""
         per_call = self.batch_size * self.iterations_per_call
         return max(1, -(-self.num_timesteps // per_call)) * self.iterations_per_call
 
@@ -92,6 +101,11 @@ class TrainConfig:
                 raise UsageError(f"TrainConfig.{name} must be > 0, got {getattr(self, name)!r}")
         if not 0 < self.discounting <= 1:
             raise UsageError(f"TrainConfig.discounting must be in (0, 1], got {self.discounting!r}")
+        if self.mode not in ("geometric", "planner"):
+            raise UsageError(f"TrainConfig.mode must be 'geometric' or 'planner', got {self.mode!r}")
+        if self.learning_rate_schedule not in ("linear", "constant"):
+            raise UsageError(f"TrainConfig.learning_rate_schedule must be 'linear' or 'constant', "
+                             f"got {self.learning_rate_schedule!r}")
         if self.num_envs % self.num_minibatches:
             raise UsageError(f"TrainConfig.num_envs ({self.num_envs}) must be a multiple of "
                              f"num_minibatches ({self.num_minibatches})")
@@ -123,15 +137,30 @@ PRESETS = {
     # under a minute on 2 cores, compile included: checks that everything runs
     "smoke": dict(num_timesteps=400_000, num_envs=512, unroll_length=16, num_minibatches=4,
                   num_epochs=4, iterations_per_call=4),
-    # about 10 minutes on 2 cores
-    "quick": dict(num_timesteps=60_000_000),
+    # about 10 minutes on 2 cores; 4 epochs of 8 mini-batches (see module doc)
+    "quick": dict(num_timesteps=60_000_000, num_epochs=4, num_minibatches=8),
     # the paper's budget: 80 M steps (paper §IV)
-    "paper": dict(num_timesteps=80_000_000),
+    "paper": dict(num_timesteps=80_000_000, num_epochs=4, num_minibatches=8),
 }
 
+# Planner mode: an iteration is `num_envs` whole episodes (up to 400 steps),
+# every guide validated by the contact generator; `num_timesteps` counts the
+# steps kept after pruning. The budget is sized by the generator's speed
+# (benchmarks/planner_training_throughput.py).
+PLANNER_PRESETS = {
+    "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
+    "quick": dict(num_timesteps=1_000_000, num_envs=64, num_minibatches=4, num_epochs=4),
+    "paper": dict(num_timesteps=80_000_000, num_envs=64, num_minibatches=4, num_epochs=10),
+}
+# the number of planner iterations depends on how much the generator keeps, so
+# a schedule over "the whole run" is not known in advance: constant rate
+for _values in PLANNER_PRESETS.values():
+    _values["learning_rate_schedule"] = "constant"
 
-def preset(name: str, **overrides) -> TrainConfig:
-    """A preset's config with keyword overrides; unknown names raise UsageError."""
-    if name not in PRESETS:
-        raise UsageError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
-    return TrainConfig(preset=name, **{**PRESETS[name], **overrides}).validate()
+
+def preset(name: str, mode: str = "geometric", **overrides) -> TrainConfig:
+    """A preset's config for `mode` with keyword overrides; unknown names raise UsageError."""
+    table = PLANNER_PRESETS if mode == "planner" else PRESETS
+    if name not in table:
+        raise UsageError(f"unknown preset {name!r}; choose one of {', '.join(table)}")
+    return TrainConfig(preset=name, mode=mode, **{**table[name], **overrides}).validate()

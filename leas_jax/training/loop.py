@@ -1,4 +1,9 @@
-"""Host side of training: progress bar, JSONL/TensorBoard logs, checkpoints, resume."""
+"""Host side of training: progress bar, JSONL/TensorBoard logs, checkpoints, resume.
+
+Two modes share everything but the iteration: geometric PPO (`ppo.py`) and
+planner-in-the-loop PPO (`planner.py`), where the contact generator's workers
+validate batch k while JAX rolls out batch k+1.
+"""
 
 from __future__ import annotations
 
@@ -11,9 +16,9 @@ from typing import Callable, Optional
 import jax
 import numpy as np
 
-from leas_jax.errors import UsageError
+from leas_jax.errors import LeasError, UsageError
 from leas_jax.training import checkpoint
-from leas_jax.training.config import TrainConfig
+from leas_jax.training.config import TrainConfig, resolve_data_path
 from leas_jax.training.ppo import TrainState, init_state, make_train_call
 
 
@@ -42,13 +47,59 @@ def _check_config(run_dir: Path, config: TrainConfig) -> None:
                          f"(differs in {', '.join(diff)}); use another --out or the same settings")
 
 
-def _summarise(raw: dict, env_steps: int, iteration: int, wall_s: float, sps: float) -> dict:
-    """Per-call metrics dict -> JSON-friendly log record."""
+class RunLog:
+    """metrics.jsonl + TensorBoard + tqdm bar + periodic atomic checkpoints of one run."""
+
+    def __init__(self, run_dir: Path, config: TrainConfig, state: TrainState, resumed: bool, progress: bool,
+                 total_steps: int, on_log: Optional[Callable[[dict], None]]):
+        from tensorboardX import SummaryWriter
+        from tqdm.auto import tqdm
+
+        self.run_dir, self.config, self.on_log = run_dir, config, on_log
+        self.path = run_dir / "metrics.jsonl"
+        lines = self.path.read_text().splitlines() if (resumed and self.path.exists()) else []
+        self.wall_before = float(json.loads(lines[-1])["wall_s"]) if lines else 0.0
+        self.writer = SummaryWriter(str(run_dir / "tb"))
+        self.bar = tqdm(total=total_steps, initial=min(int(state.env_steps), total_steps), unit="step",
+                        unit_scale=True, disable=not progress, desc=f"train {config.mode} {config.preset}")
+        self.t_start = self.last_ckpt = time.perf_counter()
+        self.record: dict = {}
+
+    def log(self, record: dict, new_steps: int) -> None:
+        record["wall_s"] = round(self.wall_before + time.perf_counter() - self.t_start, 3)
+        self.record = record
+        with open(self.path, "a") as f:
+            f.write(json.dumps(record) + "\n")
+        for k, v in record.items():
+            if k not in ("iteration", "env_steps"):
+                self.writer.add_scalar(k, v, record["env_steps"])
+        if self.on_log:
+            self.on_log(record)
+        self.bar.update(new_steps)
+        shown = {"ret": "episode_return", "invalid": "invalid_fraction", "cov": "mean_coverage"}
+        self.bar.set_postfix({k: f"{record[v]:.2f}" for k, v in shown.items() if v in record})
+
+    def maybe_checkpoint(self, state: TrainState) -> None:
+        if time.perf_counter() - self.last_ckpt > self.config.checkpoint_every_s:
+            self.checkpoint(state)
+
+    def checkpoint(self, state: TrainState) -> None:
+        steps = int(state.env_steps)
+        checkpoint.save_state(self.run_dir, state, steps, self.config.keep_checkpoints)
+        checkpoint.save_policy(self.run_dir, state.normalizer, state.params.policy, self.config.to_dict(), steps)
+        self.last_ckpt = time.perf_counter()
+
+    def close(self) -> None:
+        self.bar.close()
+        self.writer.close()
+
+
+def _summarise(raw: dict, env_steps: int, iteration: int, sps: float) -> dict:
+    """Per-call geometric metrics -> JSON-friendly log record."""
     raw = {k: float(v) for k, v in raw.items()}
     episodes = raw.pop("episodes")
     ret, length, invalid = (raw.pop(k) for k in ("episode_return_sum", "episode_length_sum", "invalid_episodes"))
-    record = {"iteration": iteration, "env_steps": env_steps, "wall_s": round(wall_s, 3), "sps": round(sps, 1),
-              "episodes": int(episodes)}
+    record = {"iteration": iteration, "env_steps": env_steps, "sps": round(sps, 1), "episodes": int(episodes)}
     if episodes > 0:
         record.update(episode_return=ret / episodes, episode_length=length / episodes,
                       invalid_fraction=invalid / episodes)
@@ -56,24 +107,36 @@ def _summarise(raw: dict, env_steps: int, iteration: int, wall_s: float, sps: fl
     return record
 
 
-def _open_tensorboard(run_dir: Path):
-    from tensorboardX import SummaryWriter
-    return SummaryWriter(str(run_dir / "tb"))
+def initial_params_from(run_dir: str | Path):
+    """(params, normalizer) of the newest full checkpoint of a run directory (for `init_from`)."""
+    found = checkpoint.list_checkpoints(resolve_data_path(run_dir))
+    if not found:
+        raise LeasError(f"{run_dir}: no checkpoints/step_*.pkl to initialise from")
+    state = checkpoint.load_state(found[-1][1])
+    return state.params, state.normalizer
 
 
 def train(config: TrainConfig, out: str | Path, progress: bool = True,
           on_log: Optional[Callable[[dict], None]] = None, stop_after_iterations: Optional[int] = None,
-          field=None) -> TrainResult:
-    """Train a LeaS policy with geometric PPO; resume if `out` holds a checkpoint.
+          field=None, workers: Optional[int] = None, address: Optional[str] = None,
+          pool_options: Optional[dict] = None) -> TrainResult:
+    """Train a LeaS policy; resume if `out` holds a checkpoint.
 
     Args:
-        config: training configuration (see `leas_jax.training.config.preset`).
+        config: training configuration (see `leas_jax.training.config.preset`);
+            `config.mode` picks geometric or planner-in-the-loop PPO.
         out: run directory (created); an existing one with checkpoints resumes.
         progress: show a tqdm progress bar.
         on_log: called with every log record (also written to metrics.jsonl).
         stop_after_iterations: stop (with a checkpoint) after this many
             iterations of this call, to split a run; None trains to the end.
         field: a prebuilt `Heightfield`; default: built from `config.terrain`.
+        workers: planner mode: contact-generator worker processes (None: one
+            per CPU minus one; 0: in this process).
+        address: planner mode: a validation backend address (e.g. a Ray
+            cluster, see `leas_jax.contacts.pool.register_backend`).
+        pool_options: planner mode: more `ValidationPool` keyword arguments
+            (task_timeout, max_attempts, plan_fn for fault-injection tests).
 
     Returns:
         TrainResult with the run directory and `policy.pkl` path.
@@ -82,68 +145,121 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
     """
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.terrain import load_terrain
-    from tqdm.auto import tqdm
 
     config.validate()
     run_dir = Path(out)
     run_dir.mkdir(parents=True, exist_ok=True)
     _check_config(run_dir, config)
+    terrain = load_terrain(config.terrain_path())
     if field is None:
-        field = heightfield_from_terrain(load_terrain(config.terrain_path()), config.env)
-
+        field = heightfield_from_terrain(terrain, config.env)
     found = checkpoint.list_checkpoints(run_dir)
     state: TrainState = init_state(config, field)
     if found:
         state = jax.tree.map(jax.numpy.asarray, checkpoint.load_state(found[-1][1]))
-    call = make_train_call(config)
-    total_iterations = config.num_iterations
-    start_iteration = int(state.iteration)
-    log_path = run_dir / "metrics.jsonl"
-    writer = _open_tensorboard(run_dir)
-    bar = tqdm(total=total_iterations * config.batch_size, initial=int(state.env_steps), unit="step",
-               unit_scale=True, disable=not progress, desc=f"train {config.preset}")
+    elif config.init_from:
+        params, normalizer = initial_params_from(config.init_from)
+        state = state.replace(params=jax.tree.map(jax.numpy.asarray, params),
+                              normalizer=jax.tree.map(jax.numpy.asarray, normalizer))
+    total = config.num_timesteps if config.mode == "planner" else config.num_iterations * config.batch_size
+    log = RunLog(run_dir, config, state, bool(found), progress, total, on_log)
+    run = _planner_iterations if config.mode == "planner" else _geometric_iterations
     t_start = time.perf_counter()
-    last_ckpt = t_start
-    record: dict = {}
-    wall_before = float(json.loads(log_path.read_text().splitlines()[-1])["wall_s"]) if (
-        found and log_path.exists() and log_path.read_text().strip()) else 0.0
     try:
-        while int(state.iteration) < total_iterations:
-            if stop_after_iterations is not None and int(state.iteration) - start_iteration >= stop_after_iterations:
+        state = run(config, state, field, terrain, log, stop_after_iterations,
+                    dict(workers=workers, address=address, **(pool_options or {})))
+    except KeyboardInterrupt:
+        log.checkpoint(state)
+        log.close()
+        raise
+    log.checkpoint(state)
+    log.close()
+    return TrainResult(run_dir=run_dir, policy_path=run_dir / "policy.pkl", env_steps=int(state.env_steps),
+                       wall_s=time.perf_counter() - t_start, metrics=log.record)
+
+
+def _geometric_iterations(config, state, field, terrain, log: RunLog, stop_after, pool_options) -> TrainState:
+    call = make_train_call(config)
+    start_iteration = int(state.iteration)
+    per_call = config.iterations_per_call * config.batch_size
+    while int(state.iteration) < config.num_iterations:
+        if stop_after is not None and int(state.iteration) - start_iteration >= stop_after:
+            break
+        t0 = time.perf_counter()
+        state, raw = call(state, field)
+        raw = jax.device_get(raw)
+        log.log(_summarise(raw, int(state.env_steps), int(state.iteration), per_call / (time.perf_counter() - t0)),
+                per_call)
+        log.maybe_checkpoint(state)
+    return state
+
+
+def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, pool_options) -> TrainState:
+    """Planner-in-the-loop PPO: validation of batch k overlaps the rollout of batch k+1.
+
+    A batch in flight when the run stops is dropped (it is re-drawn on
+    resume from the saved PRNG key); only updated states are checkpointed.
+    """
+    from leas_jax.contacts.pool import ValidationPool
+    from leas_jax.training.planner import guides_of, make_planner_fns
+
+    rollout, update = make_planner_fns(config)
+    timestep = config.env.timestep
+    state = state.replace(env_state=None, episode_return=None, episode_length=None)
+    start_iteration = int(state.iteration)
+
+    def draw(state):
+        key, k_roll, k_update = jax.random.split(state.key, 3)
+        episodes = rollout(state, field, k_roll)
+        return state.replace(key=key), episodes, k_update
+
+    pool = ValidationPool(terrain, return_plans=False, **pool_options)
+    try:
+        state, episodes, k_update = draw(state)
+        future = pool.submit(guides_of(episodes), timestep)
+        while int(state.env_steps) < config.num_timesteps:
+            if stop_after is not None and int(state.iteration) - start_iteration >= stop_after:
                 break
             t0 = time.perf_counter()
-            state, raw = call(state, field)
-            raw = jax.device_get(raw)
-            dt = time.perf_counter() - t0
-            steps = int(state.env_steps)
-            record = _summarise(raw, steps, int(state.iteration), wall_before + time.perf_counter() - t_start,
-                                config.iterations_per_call * config.batch_size / dt)
-            with open(log_path, "a") as f:
-                f.write(json.dumps(record) + "\n")
-            for k, v in record.items():
-                if k not in ("iteration", "env_steps"):
-                    writer.add_scalar(k, v, steps)
-            if on_log:
-                on_log(record)
-            bar.update(config.iterations_per_call * config.batch_size)
-            bar.set_postfix(ret=f"{record.get('episode_return', float('nan')):.1f}",
-                            invalid=f"{record.get('invalid_fraction', float('nan')):.2f}")
-            if time.perf_counter() - last_ckpt > config.checkpoint_every_s:
-                _save(run_dir, state, config)
-                last_ckpt = time.perf_counter()
-    except KeyboardInterrupt:
-        _save(run_dir, state, config)
-        bar.close()
-        writer.close()
-        raise
-    _save(run_dir, state, config)
-    bar.close()
-    writer.close()
-    return TrainResult(run_dir=run_dir, policy_path=run_dir / "policy.pkl", env_steps=int(state.env_steps),
-                       wall_s=time.perf_counter() - t_start, metrics=record)
+            # batch k+1 is drawn with the parameters from before update k (one update stale)
+            next_state, next_episodes, next_k_update = draw(state)
+            next_future = pool.submit(guides_of(next_episodes), timestep)
+            t_wait = time.perf_counter()
+            results = future.result()
+            wait_s = time.perf_counter() - t_wait
+            state, record = _apply_validated_batch(state, episodes, results, k_update, update)
+            state = state.replace(key=next_state.key)
+            episodes, future, k_update = next_episodes, next_future, next_k_update
+            elapsed = time.perf_counter() - t0
+            record.update(iteration=int(state.iteration), env_steps=int(state.env_steps),
+                          sps=round(record["kept_steps"] / elapsed, 1),
+                          rolled_sps=round(record["rolled_steps"] / elapsed, 1),
+                          validation_wait_s=round(wait_s, 3), wait_fraction=round(wait_s / elapsed, 3))
+            log.log(record, int(record["kept_steps"]))
+            log.maybe_checkpoint(state)
+    finally:
+        pool.close(cancel_pending=True)  # the batch in flight is not needed any more
+    return state
 
 
-def _save(run_dir: Path, state: TrainState, config: TrainConfig) -> None:
-    steps = int(state.env_steps)
-    checkpoint.save_state(run_dir, state, steps, config.keep_checkpoints)
-    checkpoint.save_policy(run_dir, state.normalizer, state.params.policy, config.to_dict(), steps)
+def _apply_validated_batch(state, episodes, results, key, update):
+    """Prune one validated batch, run the PPO update; (state, log record).
+
+    Paths whose validation failed (a worker died twice, a timeout, a planner
+    exception) count as not covered at all (last_valid_index -1, masked); a
+    batch where every path failed means the generator is broken: stop.
+    """
+    from leas_jax.training.planner import training_batch
+
+    errors = [r.error for r in results if r.error is not None]
+    if errors and len(errors) == len(results):
+        raise LeasError(f"contact generator failed on every path of a batch; first error: {errors[0]}")
+
+    last_valid = np.array([r.last_valid_index for r in results])
+    coverage = np.array([r.coverage for r in results])
+    batch, stats = training_batch(episodes, last_valid)
+    state, losses = update(state, batch, key)
+    record = {**stats, "mean_coverage": float(coverage.mean()), "full_coverage_fraction": float((coverage >= 1.0).mean()),
+              "generator_errors": len(errors),
+              **{k: float(v) for k, v in jax.device_get(losses).items()}}
+    return state, record

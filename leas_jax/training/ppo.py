@@ -58,7 +58,13 @@ class TrainState:
 
 
 def make_optimizer(config: TrainConfig) -> optax.GradientTransformation:
-    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(config.learning_rate))
+    """Adam with global-norm clipping; the learning rate decays linearly to 0 over the run
+    when `learning_rate_schedule == "linear"` (counted in gradient steps)."""
+    rate = config.learning_rate
+    if config.learning_rate_schedule == "linear":
+        updates = config.num_iterations * config.num_epochs * config.num_minibatches
+        rate = optax.linear_schedule(config.learning_rate, 0.0, updates)
+    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(rate))
 
 
 def init_state(config: TrainConfig, field: Heightfield) -> TrainState:

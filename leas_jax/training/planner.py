@@ -1,0 +1,221 @@
+"""Planner-in-the-loop PPO, the paper's method (DESIGN.md §7), jitted parts.
+
+One iteration:
+  1. roll out `num_envs` whole episodes (up to `episode_length` steps, fresh
+     random starts) with the stochastic policy, in JAX;
+  2. on the host, send their guide paths to the contact generator workers;
+  3. cut each episode after the generator's `last_valid_index`: the step that
+     leaves the last covered pose becomes terminal, later steps are masked out
+     of the loss, the advantage and the normaliser update;
+  4. run the PPO update (Brax's networks, GAE and distributions; the loss is
+     Brax's PPO loss with a per-step mask).
+The host loop (`leas_jax.training.loop`) overlaps step 2 of batch k with
+step 1 of batch k+1, so batch k+1 is collected with the parameters from
+before update k: the data are at most one update stale, which PPO's
+importance ratio (clipped at 1 ± epsilon) absorbs.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from brax.training import gradients
+from brax.training.acme import running_statistics
+from brax.training.agents.ppo import losses as ppo_losses
+from brax.training.agents.ppo import networks as ppo_networks
+from flax import struct
+
+from leas_jax.env import LeasEnv
+from leas_jax.env.field import Heightfield
+from leas_jax.training.config import TrainConfig
+from leas_jax.training.networks import make_networks
+from leas_jax.training.ppo import TrainState, make_optimizer
+
+
+@struct.dataclass
+class EpisodeBatch:
+    """Whole episodes, padded to T = episode_length steps. Shapes [N, T, ...] unless said.
+
+    Attributes:
+        observation: [N, T, 81] observation before each step.
+        raw_action: [N, T, 4] pre-tanh action sample (for the log-probability).
+        log_prob: [N, T] behaviour log-probability.
+        reward: [N, T].
+        done: [N, T] 1 where the episode ends at this step.
+        truncation: [N, T] 1 where it ends by the time limit.
+        alive: [N, T] 1 for steps that belong to the episode.
+        poses: [N, T + 1, 4] root poses (x, y, z, yaw), world; frozen after the end.
+        guide_length: [N] poses of the guide path: the start and every pose
+            after a step, except a final invalid pose.
+    """
+
+    observation: jax.Array
+    raw_action: jax.Array
+    log_prob: jax.Array
+    reward: jax.Array
+    done: jax.Array
+    truncation: jax.Array
+    alive: jax.Array
+    poses: jax.Array
+    guide_length: jax.Array
+
+
+def rollout_episodes(config: TrainConfig, network, state: TrainState, field: Heightfield, key) -> EpisodeBatch:
+    """`config.num_envs` whole episodes from fresh random starts (pure, jittable)."""
+    env_config = config.env
+    env = LeasEnv(field, env_config)
+    policy = ppo_networks.make_inference_fn(network)((state.normalizer, state.params.policy))
+    k_reset, k_steps = jax.random.split(key)
+    start = jax.vmap(env.reset)(jax.random.split(k_reset, config.num_envs))
+
+    def step(carry, k):
+        env_state, alive = carry  # alive: [N] 1 while the episode runs
+        actions, extras = policy(env_state.obs, k)
+        new = jax.vmap(env.step)(env_state, actions)
+        record = dict(observation=env_state.obs, raw_action=extras["raw_action"], log_prob=extras["log_prob"],
+                      reward=new.reward * alive, done=new.done * alive, truncation=new.info["truncation"] * alive,
+                      alive=alive, invalid=new.metrics["invalid"] * alive)
+        # finished episodes keep their last state (their later steps are padding)
+        running = lambda x: (alive > 0).reshape(alive.shape + (1,) * (x.ndim - 1))  # noqa: E731
+        env_state = jax.tree.map(lambda a, b: jnp.where(running(a), a, b), new, env_state)
+        record["pose"] = env_state.pipeline_state.pose
+        return (env_state, alive * (1 - new.done)), record
+
+    _, rec = jax.lax.scan(step, (start, jnp.ones(config.num_envs)),
+                          jax.random.split(k_steps, env_config.episode_length))
+    rec = jax.tree.map(lambda x: jnp.swapaxes(x, 0, 1), rec)  # [N, T, ...]
+    poses = jnp.concatenate([start.pipeline_state.pose[:, None], rec["pose"]], axis=1)
+    guide_length = 1 + (rec["alive"] - rec["invalid"]).sum(axis=1).astype(jnp.int32)
+    return EpisodeBatch(observation=rec["observation"], raw_action=rec["raw_action"], log_prob=rec["log_prob"],
+                        reward=rec["reward"], done=rec["done"], truncation=rec["truncation"], alive=rec["alive"],
+                        poses=poses, guide_length=guide_length)
+
+
+def prune_after_failure(alive: np.ndarray, done: np.ndarray, truncation: np.ndarray,
+                        guide_length: np.ndarray, last_valid_index: np.ndarray):
+    """Cut episodes after the contact generator's last valid pose (host, NumPy).
+
+    Step t moves the root from guide pose t to pose t + 1. With l = last valid
+    index: steps t < l are kept unchanged; step t = l (leaving the last
+    covered pose) becomes terminal (done 1, truncation 0); steps t > l are
+    masked. A fully covered guide (l = guide_length - 1) keeps its episode as
+    it was; l = -1 (no valid first stance) masks the whole episode.
+
+    Args:
+        alive, done, truncation: [N, T] from `EpisodeBatch`.
+        guide_length: [N] guide poses per episode.
+        last_valid_index: [N] from the contact generator.
+
+    Returns:
+        (mask, done, truncation), each [N, T] float32.
+    """
+    n, t = alive.shape
+    steps = np.arange(t)[None, :]
+    lvi = np.asarray(last_valid_index)[:, None]
+    full = lvi >= (np.asarray(guide_length)[:, None] - 1)
+    mask = alive * np.where(full, 1.0, (steps <= lvi))
+    failure_step = (~full) & (steps == lvi)
+    done = np.where(failure_step, 1.0, done) * mask
+    truncation = np.where(failure_step, 0.0, truncation) * mask
+    return mask.astype(np.float32), done.astype(np.float32), truncation.astype(np.float32)
+
+
+def masked_ppo_loss(params, normalizer, batch: dict, rng, network, config: TrainConfig):
+    """Brax's PPO loss with a per-step mask. batch: dict of [B, T, ...] arrays.
+
+    Masked steps neither contribute to the means nor carry the advantage
+    recursion (they are marked truncated for the GAE, which zeroes their
+    temporal differences and cuts the chain).
+    """
+    dist = network.parametric_action_distribution
+    logits = network.policy_network.apply(normalizer, params.policy, batch["observation"])
+    values = network.value_network.apply(normalizer, params.value, batch["observation"])
+    mask = batch["mask"]
+    truncation = jnp.maximum(batch["truncation"], 1.0 - mask)
+    termination = batch["done"] * (1.0 - truncation)
+    tm = lambda x: jnp.swapaxes(x, 0, 1)  # noqa: E731  [B, T] -> [T, B]
+    vs, advantages = ppo_losses.compute_gae(
+        truncation=tm(truncation), termination=tm(termination), rewards=tm(batch["reward"] * config.reward_scaling),
+        values=tm(values), bootstrap_value=jnp.zeros(values.shape[0]), lambda_=config.gae_lambda,
+        discount=config.discounting)
+    vs, advantages = tm(vs), tm(advantages)
+    count = jnp.maximum(mask.sum(), 1.0)
+    mean = lambda x: (x * mask).sum() / count  # noqa: E731
+    adv_mean = mean(advantages)
+    adv_std = jnp.sqrt(mean((advantages - adv_mean) ** 2))
+    advantages = (advantages - adv_mean) / (adv_std + 1e-8)
+    log_prob = dist.log_prob(logits, batch["raw_action"])
+    ratio = jnp.exp(log_prob - batch["log_prob"])
+    eps = config.clipping_epsilon
+    policy_loss = -mean(jnp.minimum(ratio * advantages, jnp.clip(ratio, 1 - eps, 1 + eps) * advantages))
+    value_loss = 0.5 * config.vf_coefficient * mean((jax.lax.stop_gradient(vs) - values) ** 2)
+    entropy = mean(dist.entropy(logits, rng))
+    total = policy_loss + value_loss - config.entropy_cost * entropy
+    return total, {"total_loss": total, "policy_loss": policy_loss, "v_loss": value_loss, "entropy": entropy}
+
+
+def make_planner_fns(config: TrainConfig):
+    """Jitted `(rollout(state, field, key) -> EpisodeBatch, update(state, batch_dict, key) -> (state, metrics))`."""
+    network = make_networks(config)
+    optimizer = make_optimizer(config)
+    loss = functools.partial(masked_ppo_loss, network=network, config=config)
+    step = gradients.gradient_update_fn(loss, optimizer, pmap_axis_name=None, has_aux=True)
+
+    def rollout(state: TrainState, field: Heightfield, key) -> EpisodeBatch:
+        return rollout_episodes(config, network, state, field, key)
+
+    def update(state: TrainState, batch: dict, key):
+        kept = batch["mask"].sum()
+        updated = running_statistics.update(state.normalizer, batch["observation"], weights=batch["mask"])
+        # a batch with every step pruned carries no statistics (a zero count would divide by zero)
+        normalizer = jax.tree.map(lambda new, old: jnp.where(kept > 0, new, old), updated, state.normalizer)
+
+        def minibatch(carry, inputs):
+            params, opt_state = carry
+            part, k = inputs
+            (_, metrics), params, opt_state = step(params, normalizer, part, k, optimizer_state=opt_state)
+            return (params, opt_state), metrics
+
+        def epoch(carry, k):
+            k_perm, k_mb = jax.random.split(k)
+            perm = jax.random.permutation(k_perm, config.num_envs)
+            parts = jax.tree.map(lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
+            return jax.lax.scan(minibatch, carry, (parts, jax.random.split(k_mb, config.num_minibatches)))
+
+        (params, opt_state), metrics = jax.lax.scan(
+            epoch, (state.params, state.optimizer_state), jax.random.split(key, config.num_epochs))
+        state = state.replace(params=params, optimizer_state=opt_state, normalizer=normalizer,
+                              env_steps=state.env_steps + kept.astype(jnp.int32), iteration=state.iteration + 1)
+        return state, {f"loss/{k}": v.mean() for k, v in metrics.items()}
+
+    return jax.jit(rollout), jax.jit(update)
+
+
+def training_batch(episodes: EpisodeBatch, last_valid_index: np.ndarray) -> tuple[dict, dict]:
+    """Host: the masked PPO batch of a validated `EpisodeBatch`, and its statistics.
+
+    Returns:
+        batch: dict of [N, T, ...] arrays for `update`.
+        stats: env_steps (alive steps), discarded_fraction, coverage inputs, episode returns.
+    """
+    host = jax.device_get(episodes)
+    mask, done, truncation = prune_after_failure(host.alive, host.done, host.truncation, host.guide_length,
+                                                 last_valid_index)
+    batch = dict(observation=host.observation, raw_action=host.raw_action, log_prob=host.log_prob,
+                 reward=host.reward, done=done, truncation=truncation, mask=mask)
+    alive_steps = float(host.alive.sum())
+    returns = (host.reward * mask).sum(axis=1)
+    stats = {"rolled_steps": alive_steps, "kept_steps": float(mask.sum()),
+             "discarded_fraction": 1.0 - float(mask.sum()) / max(alive_steps, 1.0),
+             "episode_return": float(returns.mean()), "episode_length": float(host.alive.sum(axis=1).mean()),
+             "invalid_fraction": float((host.done * (1 - host.truncation)).sum() / host.done.shape[0])}
+    return batch, stats
+
+
+def guides_of(episodes: EpisodeBatch) -> list[np.ndarray]:
+    """Host: the guide path [L_n, 4] of each episode."""
+    poses, lengths = jax.device_get((episodes.poses, episodes.guide_length))
+    return [np.asarray(poses[n, : lengths[n]], np.float64) for n in range(len(lengths))]

@@ -30,6 +30,8 @@ test-slow: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/env_throughput.py
 	$(PY) benchmarks/train_throughput.py
+	$(PY) benchmarks/contact_planner_speed.py
+	$(PY) benchmarks/planner_training_throughput.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info

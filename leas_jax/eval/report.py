@@ -42,11 +42,8 @@ def plot_learning_curves(records: list[dict], path: Path) -> None:
     plt.close(figure)
 
 
-def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terrains/eval_ground.toml") -> Path:
-    """Evaluate the run's policy and write report.md, eval.json and PNGs into `run_dir`.
-
-    Host function (loads files, runs jitted rollouts, writes files).
-    """
+def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[str], dict]:
+    """Markdown lines and figures of a geometric run: learning curves, speed and safety, rollouts."""
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.eval.geometric import arena_episodes, ground_speed
     from leas_jax.steering.commands import plot_paths
@@ -54,50 +51,34 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
     from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
 
-    run_dir = Path(run_dir)
     policy = load_policy(run_dir)
     config = policy.config
     records = read_metrics(run_dir)
     if records:
-        plot_learning_curves(records, run_dir / "learning_curves.png")
-
+        plot_learning_curves(records, out / "learning_curves.png")
     arena = load_terrain(config.terrain_path())
-    arena_field = heightfield_from_terrain(arena, config.env)
-    episodes = arena_episodes(policy, arena_field, n=n_episodes, seed=1)
+    episodes = arena_episodes(policy, heightfield_from_terrain(arena, config.env), n=n_episodes, seed=1)
     show = min(24, n_episodes)
     colors = ["tab:blue" if episodes.lengths[k] == episodes.poses.shape[1] else "tab:red" for k in range(show)]
     plot_paths(arena, [episodes.poses[k, : episodes.lengths[k]] for k in range(show)],
-               run_dir / "rollouts_arena.png", title=f"{arena.name}: {show} episodes (red: ended invalid)",
-               colors=colors)
-
-    ground = load_terrain(resolve_data_path(eval_terrain))
-    ground_field = heightfield_from_terrain(ground, config.env)
-    speed = ground_speed(policy, ground, ground_field, n=n_episodes, seed=2)
-    plot_paths(ground, speed.guides[:16], run_dir / "rollouts_ground.png",
+               out / "rollouts_arena.png", title=f"{arena.name}: {show} episodes (red: ended invalid)", colors=colors)
+    ground = load_terrain(resolve_data_path("terrains/eval_ground.toml"))
+    speed = ground_speed(policy, ground, heightfield_from_terrain(ground, config.env), n=n_episodes, seed=2)
+    plot_paths(ground, speed.guides[:16], out / "rollouts_ground.png",
                title=f"{ground.name}: 16 random headings, 400 steps")
-
-    results = {
-        "env_steps": policy.env_steps,
-        "wall_s": records[-1]["wall_s"] if records else None,
-        "final_sps": records[-1]["sps"] if records else None,
-        "ground_mean_speed": speed.mean_speed,
-        "ground_invalid_fraction": speed.invalid_fraction,
-        "arena_valid_fraction": episodes.valid_fraction,
-        "arena_stopped_fraction_of_valid": episodes.stopped_fraction,
-        "arena_mean_progress_m": episodes.mean_progress,
-        "episodes_per_metric": n_episodes,
-    }
-    atomic_write_text(run_dir / "eval.json", json.dumps(results, indent=2))
+    results = {"env_steps": policy.env_steps, "wall_s": records[-1]["wall_s"] if records else None,
+               "final_sps": records[-1]["sps"] if records else None, "ground_mean_speed": speed.mean_speed,
+               "ground_invalid_fraction": speed.invalid_fraction, "arena_valid_fraction": episodes.valid_fraction,
+               "arena_stopped_fraction_of_valid": episodes.stopped_fraction,
+               "arena_mean_progress_m": episodes.mean_progress, "episodes_per_metric": n_episodes}
     ok = lambda good: "pass" if good else "FAIL"  # noqa: E731
     last = records[-1] if records else {}
     lines = [
-        f"# LeaS run `{run_dir.name}`",
+        "## Geometric training",
         "",
         f"Preset `{config.preset}`, seed {config.seed}, terrain `{config.terrain}`, "
         f"{policy.env_steps:,} env steps in {results['wall_s'] or 0:.0f} s "
         f"(last iteration {results['final_sps'] or 0:,.0f} env steps/s).",
-        "",
-        "## Learning curves",
         "",
         "![learning curves](learning_curves.png)",
         "",
@@ -105,9 +86,7 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
         f"episode length {last.get('episode_length', float('nan')):.0f} steps, "
         f"invalid fraction {last.get('invalid_fraction', float('nan')):.3f}.",
         "",
-        "## Geometric evaluation (deterministic policy)",
-        "",
-        "| metric | value | target | |",
+        "| metric (deterministic policy) | value | target | |",
         "|---|---|---|---|",
         f"| {ground.name}: mean speed along the target direction, 400 steps, random headings "
         f"({n_episodes} episodes) | {speed.mean_speed:.3f} m/s | >= {GROUND_SPEED_TARGET} m/s "
@@ -118,13 +97,113 @@ def write_report(run_dir: Path, n_episodes: int = 256, eval_terrain: str = "terr
         f"{episodes.stopped_fraction:.3f} | | |",
         f"| {arena.name}: mean progress along the target direction | {episodes.mean_progress:.2f} m | | |",
         "",
-        "## Rollouts",
-        "",
         "![arena](rollouts_arena.png)",
         "",
         "![ground](rollouts_ground.png)",
         "",
     ]
-    path = run_dir / "report.md"
+    return lines, results
+
+
+def plot_planner_curves(records: list[dict], path: Path) -> None:
+    """PNG of the planner-mode metrics against kept env steps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    steps = np.array([r["env_steps"] for r in records], dtype=float)
+    panels = [("mean_coverage", "mean contact-plan coverage"), ("full_coverage_fraction", "fully covered paths"),
+              ("discarded_fraction", "steps discarded after failure"), ("wait_fraction", "learner waiting")]
+    figure, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.2), layout="constrained")
+    for ax, (key, label) in zip(axes, panels):
+        ax.plot(steps / 1e3, [r.get(key, np.nan) for r in records], color="tab:green")
+        ax.set_xlabel("kept env steps (k)")
+        ax.set_title(label, fontsize=10)
+        ax.grid(alpha=0.3)
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def _planner_section(geometric_dir: Path, planner_dir: Path, out: Path, compare_starts: int,
+                     workers: int) -> tuple[list[str], dict]:
+    """Markdown lines of the planner phase: curves and coverage before/after over the same starts."""
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.eval.planner_compare import arena_coverage, scenario_coverage
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.policy import load_policy
+
+    records = read_metrics(planner_dir)
+    if records:
+        plot_planner_curves(records, out / "planner_curves.png")
+    rows, results = [], {}
+    for label, run in (("geometric", geometric_dir), ("planner fine-tuned", planner_dir)):
+        policy = load_policy(run)
+        arena = load_terrain(policy.config.terrain_path())
+        cov = {"training arena": arena_coverage(policy, arena, heightfield_from_terrain(arena, policy.config.env),
+                                                n=compare_starts, workers=workers)}
+        cov.update(scenario_coverage(run, ["bridge", "stairs"], n_starts=compare_starts, workers=workers))
+        results[label] = {k: vars(v) for k, v in cov.items()}
+        rows += [f"| {label} | {name} | {c.n} | {c.row()} |" for name, c in cov.items()]
+    last = records[-1] if records else {}
+    lines = [
+        "## Planner-in-the-loop fine-tuning",
+        "",
+        f"{last.get('env_steps', 0):,} kept env steps in {last.get('wall_s', 0):.0f} s; last iteration: "
+        f"{last.get('sps', 0):,.0f} kept steps/s, learner waiting {100 * last.get('wait_fraction', 0):.0f} % "
+        f"of the time, {100 * last.get('discarded_fraction', 0):.0f} % of the steps discarded.",
+        "",
+        "![planner curves](planner_curves.png)",
+        "",
+        "Contact-plan coverage of the deterministic policy, before and after, over the same starts:",
+        "",
+        "| policy | terrain | paths | mean coverage | fully covered |",
+        "|---|---|---|---|---|",
+        *rows,
+        "",
+    ]
+    return lines, results
+
+
+def _baseline_section(planner_dir: Path, out: Path, n_starts: int, workers: int) -> tuple[list[str], dict]:
+    """Table II (ground scenario) with RBLin, RBKino and the trained policy, beside the paper."""
+    from leas_jax.eval.evaluate import evaluate
+    from leas_jax.eval.tables import table_ii_markdown
+
+    report = evaluate(["ground"], methods=["rblin", "rbkino", "leas"], checkpoint=planner_dir,
+                      out=out / "evaluation", n_starts=n_starts, workers=workers, progress=False)
+    lines = ["## Against the baselines", "",
+             f"{n_starts} trajectories per Table II cell (the paper: 60), the policy above against RBLin and "
+             "RBKino; full outputs in `evaluation/`.", "",
+             table_ii_markdown(report["table_ii"]), "",
+             *[f"![{name}](evaluation/{name})" for name in report.get("figures", [])], ""]
+    return lines, {"table_ii": report["table_ii"]}
+
+
+def write_report(out: Path, n_episodes: int = 256, compare_starts: int = 24, baseline_starts: int = 10,
+                 workers: int = 2) -> Path:
+    """Evaluate a `leas run` directory and write report.md, eval.json and PNGs into it.
+
+    `out` holds `geometric/` (and, after planner fine-tuning, `planner/`), or
+    is itself a single run directory (with `policy.pkl`).
+
+    Host function (loads files, runs jitted rollouts and contact planning, writes files).
+    """
+    out = Path(out)
+    geometric = out / "geometric" if (out / "geometric").is_dir() else out
+    planner = out / "planner" if (out / "planner" / "policy.pkl").exists() else None
+    lines = [f"# LeaS run `{out.name}`", ""]
+    section, results = _geometric_section(geometric, out, n_episodes)
+    lines += section
+    summary = {"geometric": results}
+    if planner is not None:
+        section, results = _planner_section(geometric, planner, out, compare_starts, workers)
+        lines += section
+        summary["planner"] = results
+    section, results = _baseline_section(planner or geometric, out, baseline_starts, workers)
+    lines += section
+    summary["baselines"] = results
+    atomic_write_text(out / "eval.json", json.dumps(summary, indent=2, default=float))
+    path = out / "report.md"
     atomic_write_text(path, "\n".join(lines))
     return path

@@ -80,12 +80,24 @@ def cmd_train(args) -> int:
 
 
 def cmd_run(args) -> int:
+    """Geometric training, planner-in-the-loop fine-tuning, evaluation report (each phase resumes)."""
     from leas_jax.eval.report import write_report
+    from leas_jax.training.config import preset
     from leas_jax.training.loop import train
 
-    config = config_from_args(args)
-    result = train(config, args.out, progress=not args.no_progress)
-    report = write_report(Path(args.out), n_episodes=args.eval_episodes)
+    out = Path(args.out)
+    if args.mode != "geometric" or args.init is not None:
+        raise UsageError("leas run trains both phases itself: drop --mode and --init")
+    geometric = config_from_args(args)
+    train(geometric, out / "geometric", progress=not args.no_progress)
+    if args.planner_steps > 0:
+        overrides = {"num_timesteps": args.planner_steps, "init_from": str(out / "geometric"),
+                     "terrain": geometric.terrain, "seed": geometric.seed}
+        train(preset(args.preset, mode="planner", **overrides), out / "planner", progress=not args.no_progress,
+              workers=args.workers, address=args.ray_address)
+    workers = 2 if args.workers is None else args.workers
+    report = write_report(out, n_episodes=args.eval_episodes, compare_starts=args.compare_starts,
+                          baseline_starts=args.baseline_starts, workers=workers)
     print(f"report: {report}")
     return 0
 
@@ -99,10 +111,18 @@ def register(subparsers) -> None:
     _add_training_arguments(train)
     train.set_defaults(func=cmd_train)
 
-    run = subparsers.add_parser("run", help="the main job: train, evaluate, write report.md",
-                                description="Train (resuming if possible), evaluate the policy and write "
-                                            "<out>/report.md with learning curves and rollout plots.")
+    run = subparsers.add_parser("run", help="the main job: train, fine-tune with the planner, evaluate",
+                                description="Geometric training (<out>/geometric), planner-in-the-loop "
+                                            "fine-tuning (<out>/planner), then <out>/report.md: learning "
+                                            "curves, rollouts, coverage before/after, Table II against the "
+                                            "baselines. Each phase resumes if interrupted.")
     _add_training_arguments(run)
     run.add_argument("--eval-episodes", type=_positive_int, default=256,
-                     help="episodes per evaluation metric (default 256)")
+                     help="episodes per geometric evaluation metric (default 256)")
+    run.add_argument("--planner-steps", type=int, default=150_000,
+                     help="kept env steps of planner-in-the-loop fine-tuning (default 150 000; 0 skips it)")
+    run.add_argument("--compare-starts", type=_positive_int, default=24,
+                     help="starts per terrain for the before/after coverage comparison (default 24)")
+    run.add_argument("--baseline-starts", type=_positive_int, default=10,
+                     help="trajectories per Table II cell in the report (default 10; the paper: 60)")
     run.set_defaults(func=cmd_run)

@@ -149,7 +149,7 @@ PRESETS = {
 # (benchmarks/planner_training_throughput.py).
 PLANNER_PRESETS = {
     "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
-    "quick": dict(num_timesteps=1_000_000, num_envs=64, num_minibatches=4, num_epochs=4),
+    "quick": dict(num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4),
     "paper": dict(num_timesteps=80_000_000, num_envs=64, num_minibatches=4, num_epochs=10),
 }
 # the number of planner iterations depends on how much the generator keeps, so

@@ -12,16 +12,6 @@ from leas_jax.training import preset, train
 ARENA = "terrains/training_arena.toml"
 
 
-@pytest.fixture(scope="module")
-def run_dir(tmp_path_factory):
-    """A tiny policy trained on the real arena (a few seconds)."""
-    out = tmp_path_factory.mktemp("run")
-    config = preset("smoke", num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8, num_minibatches=2,
-                    num_epochs=1, iterations_per_call=2)
-    train(config, out, progress=False)
-    return out
-
-
 @pytest.mark.parametrize("argv, fragment", [
     (["train", "--preset", "fast", "--out", "x"], "invalid choice: 'fast'"),
     (["train", "--out", "x", "--timesteps", "-5"], "expected a positive integer"),

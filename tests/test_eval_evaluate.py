@@ -33,16 +33,6 @@ seed = 0
 """
 
 
-@pytest.fixture(scope="module")
-def run_dir(tmp_path_factory):
-    """A tiny policy trained on the real arena (a few seconds)."""
-    out = tmp_path_factory.mktemp("run")
-    config = preset("smoke", num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8, num_minibatches=2,
-                    num_epochs=1, iterations_per_call=2)
-    train(config, out, progress=False)
-    return out
-
-
 def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
     terrain = tmp_path / "wall.toml"
     terrain.write_text(WALL_SCENARIO)

@@ -28,15 +28,6 @@ seed = 0
 """
 
 
-@pytest.fixture(scope="module")
-def run_dir(tmp_path_factory):
-    out = tmp_path_factory.mktemp("run")
-    config = preset("smoke", num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8, num_minibatches=2,
-                    num_epochs=1, iterations_per_call=2)
-    train(config, out, progress=False)
-    return out
-
-
 def _execute(name: str, env: dict, cwd: Path):
     notebook = nbformat.read(NOTEBOOKS / name, as_version=4)
     old = {k: os.environ.get(k) for k in env}

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from leas_jax.contacts.model import matrix_from_quat_xyzw
+
 # Sole rectangle of Talos, centred on the sole frame (DESIGN §6 check 1).
 SOLE_LENGTH = 0.20  # m, along the sole frame x
 SOLE_WIDTH = 0.13  # m, along the sole frame y
@@ -50,23 +52,7 @@ def _terrain_of(plan):
     return terrain
 
 
-def quaternion_xyzw_to_matrix(quat: np.ndarray) -> np.ndarray:
-    """Rotation matrices of unit quaternions in Pinocchio order.
-
-    Args:
-        quat: [..., 4] (x, y, z, w).
-
-    Returns:
-        [..., 3, 3] rotation matrices.
-    """
-    q = np.asarray(quat, dtype=np.float64)
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
+quaternion_xyzw_to_matrix = matrix_from_quat_xyzw  # one conversion, in contacts.model
 
 
 def footprints(plan) -> list[tuple[int, int, np.ndarray]]:

@@ -21,25 +21,29 @@ def read_metrics(run_dir: Path) -> list[dict]:
     return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
 
 
-def plot_learning_curves(records: list[dict], path: Path) -> None:
-    """PNG of episode return, episode length and invalid fraction against env steps."""
+def plot_curves(records: list[dict], panels: list[tuple[str, str]], path: Path, steps_scale: float = 1e6,
+                steps_label: str = "env steps (M)", color: str = "tab:blue") -> None:
+    """PNG with one panel per (metric key, title) against env steps."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    steps = np.array([r["env_steps"] for r in records], dtype=float)
-    panels = [("episode_return", "episode return"), ("episode_length", "episode length (steps)"),
-              ("invalid_fraction", "episodes ending invalid (fraction)"), ("sps", "env steps / s")]
+    steps = np.array([r["env_steps"] for r in records], dtype=float) / steps_scale
     figure, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.2), layout="constrained")
     for ax, (key, label) in zip(axes, panels):
-        values = np.array([r.get(key, np.nan) for r in records], dtype=float)
-        ax.plot(steps / 1e6, values, color="tab:blue")
-        ax.set_xlabel("env steps (M)")
+        ax.plot(steps, np.array([r.get(key, np.nan) for r in records], dtype=float), color=color)
+        ax.set_xlabel(steps_label)
         ax.set_title(label, fontsize=10)
         ax.grid(alpha=0.3)
     figure.savefig(path, dpi=110)
     plt.close(figure)
+
+
+GEOMETRIC_PANELS = [("episode_return", "episode return"), ("episode_length", "episode length (steps)"),
+                    ("invalid_fraction", "episodes ending invalid (fraction)"), ("sps", "env steps / s")]
+PLANNER_PANELS = [("mean_coverage", "mean contact-plan coverage"), ("full_coverage_fraction", "fully covered paths"),
+                  ("discarded_fraction", "steps discarded after failure"), ("wait_fraction", "learner waiting")]
 
 
 def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[str], dict]:
@@ -55,7 +59,7 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     config = policy.config
     records = read_metrics(run_dir)
     if records:
-        plot_learning_curves(records, out / "learning_curves.png")
+        plot_curves(records, GEOMETRIC_PANELS, out / "learning_curves.png")
     arena = load_terrain(config.terrain_path())
     episodes = arena_episodes(policy, heightfield_from_terrain(arena, config.env), n=n_episodes, seed=1)
     show = min(24, n_episodes)
@@ -105,26 +109,6 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     return lines, results
 
 
-def plot_planner_curves(records: list[dict], path: Path) -> None:
-    """PNG of the planner-mode metrics against kept env steps."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    steps = np.array([r["env_steps"] for r in records], dtype=float)
-    panels = [("mean_coverage", "mean contact-plan coverage"), ("full_coverage_fraction", "fully covered paths"),
-              ("discarded_fraction", "steps discarded after failure"), ("wait_fraction", "learner waiting")]
-    figure, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.2), layout="constrained")
-    for ax, (key, label) in zip(axes, panels):
-        ax.plot(steps / 1e3, [r.get(key, np.nan) for r in records], color="tab:green")
-        ax.set_xlabel("kept env steps (k)")
-        ax.set_title(label, fontsize=10)
-        ax.grid(alpha=0.3)
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-
-
 def _planner_section(geometric_dir: Path, planner_dir: Path, out: Path, compare_starts: int,
                      workers: int) -> tuple[list[str], dict]:
     """Markdown lines of the planner phase: curves and coverage before/after over the same starts."""
@@ -135,7 +119,8 @@ def _planner_section(geometric_dir: Path, planner_dir: Path, out: Path, compare_
 
     records = read_metrics(planner_dir)
     if records:
-        plot_planner_curves(records, out / "planner_curves.png")
+        plot_curves(records, PLANNER_PANELS, out / "planner_curves.png", steps_scale=1e3,
+                    steps_label="kept env steps (k)", color="tab:green")
     rows, results = [], {}
     for label, run in (("geometric", geometric_dir), ("planner fine-tuned", planner_dir)):
         policy = load_policy(run)

@@ -22,7 +22,7 @@ def _add_training_arguments(parser) -> None:
     from leas_jax.training.config import PRESETS
 
     parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
-                        help="smoke (< 1 min), quick (~10 min on 2 cores), paper (80 M steps)")
+                        help="smoke (< 1 min), quick (80 M steps, 3 epochs, ~7 min on 2 cores), paper (80 M steps, 10 epochs)")
     parser.add_argument("--mode", default="geometric", choices=["geometric", "planner"],
                         help="geometric: reachability condition only; planner: every episode validated by the "
                              "Talos contact generator (the paper's method)")

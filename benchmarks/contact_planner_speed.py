@@ -105,6 +105,89 @@ def stairs_case(rise: float = 0.10, steps: int = 6, tread: float = 0.30, start: 
 
 
 CASES = {"flat": flat_case, "uturn": uturn_case, "stairs": stairs_case}
+PLAN_ARRAYS = ("q", "feet", "guide_index", "last_valid_index", "coverage")
+
+ARENA = Path(__file__).resolve().parent.parent / "terrains" / "training_arena.toml"
+ARENA_SEED = 0
+ARENA_MAX_SPEED = 0.3  # m/s, above the paper's 0.18 m/s (early-training policies)
+ARENA_MAX_YAW_RATE = math.pi / 9  # rad/s, omega_max (DESIGN §5)
+
+
+def _arena_start(terrain, rng, pose_ok) -> np.ndarray:
+    """A random (x, y, yaw) of the arena where the generator can stand (double support)."""
+    lo, hi = terrain.bounds[0] + 0.5, terrain.bounds[1] - 0.5
+    while True:
+        x, y = rng.uniform(lo, hi)
+        yaw = rng.uniform(-math.pi, math.pi)
+        z = float(terrain.height_at(np.array([x, y]))) + NOMINAL_ROOT_HEIGHT
+        pose = np.array([x, y, z, yaw])
+        if pose_ok(pose):
+            return pose
+
+
+def arena_guides(count: int = 24, seed: int = ARENA_SEED, length: int = 200, pose_ok=None):
+    """Deterministic arena workload: (terrain, [guides [T, 4]]), DT between poses.
+
+    The first half are random walks (speed and yaw rate re-drawn uniformly every
+    pose in [0, ARENA_MAX_SPEED] and [-ARENA_MAX_YAW_RATE, ARENA_MAX_YAW_RATE], like a
+    random policy), the second half straight lines or constant turns (speed 0.1-0.3
+    m/s, yaw rate 0 for even guides, else a random constant); all `length` poses, root
+    NOMINAL_ROOT_HEIGHT above `terrain.height_at`, starting where the generator can
+    stand (`pose_ok(pose)`, default `ContactGenerator.double_support(pose) is not None`).
+    Seeded NumPy: the same guides on every machine (given the same generator).
+    """
+    from leas_jax.terrain import load_terrain
+
+    terrain = load_terrain(ARENA)
+    rng = np.random.default_rng(seed)
+    if pose_ok is None:
+        generator = ContactGenerator(terrain, GeneratorConfig())
+        pose_ok = lambda pose: generator.double_support(pose) is not None  # noqa: E731
+    guides = []
+    lo, hi = terrain.bounds[0], terrain.bounds[1]
+    for k in range(count):
+        start = _arena_start(terrain, rng, pose_ok)
+        walk = k < count // 2
+        if walk:
+            speed = rng.uniform(0.0, ARENA_MAX_SPEED, length)
+            omega = rng.uniform(-ARENA_MAX_YAW_RATE, ARENA_MAX_YAW_RATE, length)
+        else:
+            speed = np.full(length, rng.uniform(0.1, ARENA_MAX_SPEED))
+            omega = np.full(length, 0.0 if k % 2 == 0 else rng.uniform(-ARENA_MAX_YAW_RATE, ARENA_MAX_YAW_RATE))
+        xyyaw = np.empty((length, 3))
+        xyyaw[0] = start[[0, 1, 3]]
+        for t in range(1, length):
+            x, y, yaw = xyyaw[t - 1]
+            yaw = yaw + omega[t] * DT
+            xyyaw[t] = (x + speed[t] * DT * math.cos(yaw), y + speed[t] * DT * math.sin(yaw), yaw)
+        xyyaw[:, :2] = np.clip(xyyaw[:, :2], lo, hi)
+        z = terrain.height_at(xyyaw[:, :2]) + NOMINAL_ROOT_HEIGHT
+        guides.append(np.stack([xyyaw[:, 0], xyyaw[:, 1], z, xyyaw[:, 2]], axis=1))
+    return terrain, guides
+
+
+def measure_arena(runs: int) -> dict:
+    """Arena workload: guide poses per CPU-second (all submitted poses / CPU time of planning them)."""
+    terrain, guides = arena_guides()
+    generator = ContactGenerator(terrain, GeneratorConfig())
+    plans = [generator.plan(g, DT) for g in guides]  # warm-up
+    cpu, wall = [], []
+    for _ in range(runs):
+        start, start_cpu = time.perf_counter(), time.process_time()
+        for guide, plan in zip(guides, plans):
+            again = generator.plan(guide, DT)
+            assert again.coverage == plan.coverage and np.array_equal(again.q, plan.q)
+        wall.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
+    poses = sum(len(g) for g in guides)
+    covered = sum(p.last_valid_index + 1 for p in plans)
+    median = statistics.median(cpu)
+    return {"guides": len(guides), "guide_poses": poses, "covered_poses": covered,
+            "failed_guides": sum(p.last_valid_index < len(g) - 1 for p, g in zip(plans, guides)),
+            "mean_coverage": float(np.mean([p.coverage for p in plans])),
+            "best_s": min(cpu), "median_s": median, "wall_median_s": statistics.median(wall),
+            "poses_per_cpu_s_median": poses / median, "poses_per_cpu_s_best": poses / min(cpu),
+            "covered_poses_per_cpu_s_median": covered / median, "runs": runs}
 
 
 def footsteps(plan) -> int:
@@ -137,48 +220,138 @@ def profile(name: str, runs: int) -> None:
     import cProfile
     import pstats
 
-    terrain, guide = CASES[name]()
+    if name == "arena":
+        terrain, guides = arena_guides()
+    else:
+        terrain, guide = CASES[name]()
+        guides = [guide]
     generator = ContactGenerator(terrain, GeneratorConfig())
-    generator.plan(guide, DT)
+    for guide in guides:
+        generator.plan(guide, DT)
     prof = cProfile.Profile()
     prof.enable()
     for _ in range(runs):
-        generator.plan(guide, DT)
+        for guide in guides:
+            generator.plan(guide, DT)
     prof.disable()
-    pstats.Stats(prof).sort_stats("tottime").print_stats(25)
+    stats = pstats.Stats(prof)
+    stats.sort_stats("tottime").print_stats(25)
+    stats.sort_stats("cumulative").print_stats(30)
+
+
+def same_array(a, b) -> bool:
+    """Exact equality of two arrays (same shape, dtype kind, values; NaN equals NaN)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape:
+        return False
+    if a.dtype.kind == "f" or b.dtype.kind == "f":
+        return bool(np.array_equal(a, b, equal_nan=True))
+    return bool(np.array_equal(a, b))
+
+
+def save_reference(path: str) -> None:
+    """Save the arena guides and their plans (PLAN_ARRAYS) to an .npz."""
+    terrain, guides = arena_guides()
+    generator = ContactGenerator(terrain, GeneratorConfig())
+    arrays = {}
+    for k, guide in enumerate(guides):
+        plan = generator.plan(guide, DT)
+        arrays[f"guide_{k}"] = guide
+        for key in PLAN_ARRAYS:
+            arrays[f"{key}_{k}"] = np.asarray(getattr(plan, key))
+    for name, case in CASES.items():
+        case_terrain, guide = case()
+        plan = ContactGenerator(case_terrain, GeneratorConfig()).plan(guide, DT)
+        for key in PLAN_ARRAYS:
+            arrays[f"{key}_{name}"] = np.asarray(getattr(plan, key))
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    np.savez(path, count=len(guides), **arrays)
+    print(f"saved {len(guides)} guides and plans to {path}")
+
+
+def check_reference(path: str) -> bool:
+    """Plan the saved guides again; compare every PLAN_ARRAYS entry exactly. True if all equal."""
+    from leas_jax.terrain import load_terrain
+
+    data = np.load(path)
+    generator = ContactGenerator(load_terrain(ARENA), GeneratorConfig())
+    same = True
+    for k in range(int(data["count"])):
+        plan = generator.plan(data[f"guide_{k}"], DT)
+        for key in PLAN_ARRAYS:
+            if not same_array(getattr(plan, key), data[f"{key}_{k}"]):
+                print(f"guide {k}: {key} differs")
+                same = False
+    for name, case in CASES.items():
+        case_terrain, guide = case()
+        plan = ContactGenerator(case_terrain, GeneratorConfig()).plan(guide, DT)
+        for key in PLAN_ARRAYS:
+            if f"{key}_{name}" in data and not same_array(getattr(plan, key), data[f"{key}_{name}"]):
+                print(f"case {name}: {key} differs")
+                same = False
+    print(f"{int(data['count'])} arena guides and {len(CASES)} cases: {'identical' if same else 'DIFFERENT'} plans")
+    return same
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=20, help="timed runs per guide after one warm-up (>= 20)")
-    parser.add_argument("--profile", choices=sorted(CASES), help="print a cProfile of this guide instead")
+    parser.add_argument("--profile", choices=sorted([*CASES, "arena"]), help="print a cProfile of this guide instead")
+    parser.add_argument("--cases", default=",".join([*CASES, "arena"]),
+                        help="comma-separated cases to time (flat, uturn, stairs, arena)")
+    parser.add_argument("--arena-runs", type=int, default=3, help="timed runs of the arena workload")
+    parser.add_argument("--save-reference", metavar="NPZ", help="save the arena guides and plans, then exit")
+    parser.add_argument("--check-reference", metavar="NPZ", help="re-plan saved arena guides, compare, then exit")
     args = parser.parse_args(argv)
+    if args.save_reference:
+        save_reference(args.save_reference)
+        return
+    if args.check_reference:
+        sys.exit(0 if check_reference(args.check_reference) else 1)
     if args.profile:
         profile(args.profile, args.runs)
         return
+    names = [n.strip() for n in args.cases.split(",") if n.strip()]
+    unknown = sorted(set(names) - {*CASES, "arena"})
+    if unknown:
+        parser.error(f"unknown case(s) {unknown}; choose from {[*CASES, 'arena']}")
     load_before = os.getloadavg()[0]
-    results = {name: measure(name, args.runs) for name in CASES}
-    mean_step = statistics.mean(r["median_ms_per_footstep"] for r in results.values())
+    results = {name: measure(name, args.runs) for name in CASES if name in names}
+    arena = measure_arena(args.arena_runs) if "arena" in names else None
     print(f"CPU ms per path ((wall) = wall-clock median), load average {load_before:.2f} before, "
           f"{os.getloadavg()[0]:.2f} after")
-    print(f"{'guide':8s} {'poses':>5s} {'steps':>5s} {'coverage':>8s} {'best ms':>8s} {'median ms':>9s} "
-          f"{'(wall)':>7s} {'ms/step (median)':>16s}")
-    for name, r in results.items():
-        print(f"{name:8s} {r['guide_poses']:5d} {r['footsteps']:5d} {r['coverage']:8.3f} {r['best_ms']:8.1f} "
-              f"{r['median_ms']:9.1f} {r['wall_median_ms']:7.1f} {r['median_ms_per_footstep']:16.2f}")
-    flat = results["flat"]
-    flat_ok = flat["median_ms"] <= PATH_TARGET_MS
-    print(f"flat path (target <= {PATH_TARGET_MS:.0f} ms): best {flat['best_ms']:.1f} ms "
-          f"({'met' if flat['best_ms'] <= PATH_TARGET_MS else 'MISSED'}), median {flat['median_ms']:.1f} ms "
-          f"({'met' if flat_ok else 'MISSED'})")
-    print(f"mean over guides: {mean_step:.2f} ms per footstep (target <= {STEP_TARGET_MS:.0f}): "
-          f"{'met' if mean_step <= STEP_TARGET_MS else 'MISSED'}")
+    summary = {}
+    if results:
+        mean_step = statistics.mean(r["median_ms_per_footstep"] for r in results.values())
+        print(f"{'guide':8s} {'poses':>5s} {'steps':>5s} {'coverage':>8s} {'best ms':>8s} {'median ms':>9s} "
+              f"{'(wall)':>7s} {'ms/step (median)':>16s}")
+        for name, r in results.items():
+            print(f"{name:8s} {r['guide_poses']:5d} {r['footsteps']:5d} {r['coverage']:8.3f} {r['best_ms']:8.1f} "
+                  f"{r['median_ms']:9.1f} {r['wall_median_ms']:7.1f} {r['median_ms_per_footstep']:16.2f}")
+        summary["mean_median_ms_per_footstep"] = mean_step
+        summary["footstep_target_met"] = mean_step <= STEP_TARGET_MS
+        if "flat" in results:
+            flat = results["flat"]
+            flat_ok = flat["median_ms"] <= PATH_TARGET_MS
+            print(f"flat path (target <= {PATH_TARGET_MS:.0f} ms): best {flat['best_ms']:.1f} ms "
+                  f"({'met' if flat['best_ms'] <= PATH_TARGET_MS else 'MISSED'}), median {flat['median_ms']:.1f} ms "
+                  f"({'met' if flat_ok else 'MISSED'})")
+            summary["flat_target_met"] = flat_ok
+            summary["flat_target_met_best"] = flat["best_ms"] <= PATH_TARGET_MS
+        print(f"mean over guides: {mean_step:.2f} ms per footstep (target <= {STEP_TARGET_MS:.0f}): "
+              f"{'met' if mean_step <= STEP_TARGET_MS else 'MISSED'}")
+    if arena is not None:
+        print(f"arena: {arena['guides']} guides ({arena['failed_guides']} fail part-way, mean coverage "
+              f"{arena['mean_coverage']:.3f}), {arena['guide_poses']} guide poses: "
+              f"{arena['poses_per_cpu_s_median']:.0f} guide poses per CPU-second (median of {arena['runs']}; "
+              f"best {arena['poses_per_cpu_s_best']:.0f}; {arena['covered_poses_per_cpu_s_median']:.0f} covered poses "
+              f"per CPU-second), {arena['median_s']:.2f} s CPU per workload")
+        results["arena"] = arena
     save("contact_planner_speed", {
-        "threads": 1, "clock": "process_time (CPU); wall_* perf_counter", "timestep_s": DT, "speed_m_s": SPEED, "load_average_1min_before": load_before,
+        "threads": 1, "clock": "process_time (CPU); wall_* perf_counter", "timestep_s": DT, "speed_m_s": SPEED,
+        "load_average_1min_before": load_before, "load_average_1min_after": os.getloadavg()[0],
         "targets": {"flat_path_ms": PATH_TARGET_MS, "ms_per_footstep": STEP_TARGET_MS},
-        "cases": results, "mean_median_ms_per_footstep": mean_step,
-        "flat_target_met": flat_ok, "flat_target_met_best": flat["best_ms"] <= PATH_TARGET_MS, "footstep_target_met": mean_step <= STEP_TARGET_MS})
-
+        "cases": results, **summary})
 
 if __name__ == "__main__":
     main()

@@ -39,6 +39,18 @@ class TerrainCollision:
     transforms: list
     aabb: np.ndarray
 
+    def __post_init__(self):
+        # Per-axis columns of the bounds, contiguous: `boxes_near` compares [B] vectors.
+        self._lo = [np.ascontiguousarray(self.aabb[:, 0, k]) for k in range(3)]
+        self._hi = [np.ascontiguousarray(self.aabb[:, 1, k]) for k in range(3)]
+
+    def boxes_near(self, lo, hi) -> np.ndarray:
+        """Sorted indices of the boxes whose bounds meet the box [lo, hi] (closed sets)."""
+        near = (self._lo[0] <= hi[0]) & (self._hi[0] >= lo[0])
+        for k in (1, 2):
+            near &= (self._lo[k] <= hi[k]) & (self._hi[k] >= lo[k])
+        return np.flatnonzero(near)
+
 
 _TERRAIN_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -187,12 +199,18 @@ class RobotCollision:
         if len(terrain.aabb) == 0:
             return []
         aabb = self.world_aabb(rot, pos) if aabb is None else aabb
-        overlap = np.all((aabb[:, None, 0] <= terrain.aabb[None, :, 1]) &
-                         (aabb[:, None, 1] >= terrain.aabb[None, :, 0]), axis=2)
+        # Only the boxes meeting the bounds of the whole robot can meet one of its
+        # geometries: the [G, B] test runs on those (same pairs, same order as on all).
+        near = terrain.boxes_near(aabb[:, 0].min(axis=0).tolist(), aabb[:, 1].max(axis=0).tolist())
+        if len(near) == 0:
+            return []
+        box_lo, box_hi = terrain.aabb[near, 0], terrain.aabb[near, 1]
+        overlap = np.all((aabb[:, None, 0] <= box_hi[None]) & (aabb[:, None, 1] >= box_lo[None]), axis=2)
         hits = []
         request = coal.CollisionRequest()
         result = coal.CollisionResult()
-        for g, b in zip(*np.nonzero(overlap)):
+        for g, k in zip(*np.nonzero(overlap)):
+            b = near[k]
             result.clear()
             tf = coal.Transform3s(rot[g], pos[g])
             if coal.collide(self.geometries[g], tf, terrain.shapes[b], terrain.transforms[b], request, result):

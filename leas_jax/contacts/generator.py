@@ -47,6 +47,11 @@ from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corne
 from leas_jax.errors import UsageError
 
 
+# m, how far outside the support polygon a CoM must be for `_build` to reject a flat
+# stance without the equilibrium LP (far above rounding, far below any real margin)
+_OUTSIDE_MARGIN = 1e-6
+
+
 @dataclass(frozen=True)
 class GeneratorConfig:
     """Settings of the contact generator; defaults from DESIGN §6 and the Talos model."""
@@ -237,7 +242,13 @@ class ContactGenerator:
                     continue
             points = np.concatenate([pos + SOLE_CORNERS @ rot.T for _, pos, rot in contacts])
             normals = np.repeat(np.array([rot[:, 2] for _, _, rot in contacts]), 4, axis=0)
-            if flat_support_margin(points, normals, com) < cfg.flat_com_margin:
+            margin = flat_support_margin(points, normals, com)
+            if margin < cfg.flat_com_margin:
+                # Coplanar horizontal contacts with the CoM strictly outside their hull:
+                # no static equilibrium (the centre of pressure would have to be the CoM's
+                # projection), the LP's robustness is < 0; rejected without the LP.
+                if -math.inf < margin < -_OUTSIDE_MARGIN and cfg.min_robustness >= 0.0:
+                    return None
                 self.equilibrium.set_contacts(points, normals)
                 if self.equilibrium.robustness(com) < cfg.min_robustness:
                     return None

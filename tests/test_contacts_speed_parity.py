@@ -200,3 +200,22 @@ def test_plans_match_saved_reference():
     for k in range(int(data["count"])):
         plan = generator.plan(data[f"guide_{k}"], bench.DT)
         assert_same_plan(plan, {key: data[f"{key}_{k}"] for key in PLAN_ARRAYS}, f"arena guide {k}")
+
+
+def test_near_disk_and_column_match_near_column():
+    """`near_disk` + `near_column_z` (one disk for several faces) = `near_column` = brute force."""
+    from leas_jax.contacts.database import leg_database
+
+    rng = np.random.default_rng(4)
+    for side in (0, 1):
+        db = leg_database(side)
+        lo, hi = db.bounds
+        for _ in range(100):
+            point = rng.uniform(lo - 0.05, hi + 0.05)
+            radius, half = rng.uniform(0.02, 0.2), rng.uniform(0.02, 0.15)
+            dx, dy = db.positions[:, 0] - point[0], db.positions[:, 1] - point[1]
+            brute = np.flatnonzero((dx * dx + dy * dy <= radius * radius) &
+                                   (np.abs(db.positions[:, 2] - point[2]) <= half))
+            column = db.near_column(point, radius, half)
+            assert np.array_equal(column, brute)
+            assert np.array_equal(db.near_column_z(db.near_disk(point, radius), point[2], half), brute)

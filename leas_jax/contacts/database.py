@@ -78,11 +78,40 @@ class LegDatabase:
         Python list of ~600 indices into an array cost more than the query itself.
         """
         point = np.asarray(point, dtype=np.float64)
+        return self.near_column_z(self.near_disk(point, radius), point[2], half_height)
+
+    def near_disk(self, point, radius: float) -> np.ndarray:
+        """Indices (sorted) of the samples whose (x, y) lies within `radius` of point[:2]
+        (root frame): the first half of `near_column`, shared by columns at several heights."""
+        point = np.asarray(point, dtype=np.float64)
         idx = self._grid_xy().query(point[:2], radius)
-        near = self.positions[idx]
-        dx, dy = near[:, 0] - point[0], near[:, 1] - point[1]
-        keep = (dx * dx + dy * dy <= radius * radius) & (np.abs(near[:, 2] - point[2]) <= half_height)
-        return idx[keep]
+        dx, dy = self._x[idx] - point[0], self._y[idx] - point[1]
+        return idx[dx * dx + dy * dy <= radius * radius]
+
+    def near_column_z(self, idx: np.ndarray, z: float, half_height: float) -> np.ndarray:
+        """The samples of `idx` (from `near_disk`) within +-`half_height` of height z: with
+        `near_disk`, the same indices as `near_column` (same tests, same order)."""
+        return idx[np.abs(self._z[idx] - z) <= half_height]
+
+    @property
+    def _x(self) -> np.ndarray:
+        return self._columns()[0]
+
+    @property
+    def _y(self) -> np.ndarray:
+        return self._columns()[1]
+
+    @property
+    def _z(self) -> np.ndarray:
+        return self._columns()[2]
+
+    def _columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Contiguous x, y, z columns of `positions` (gathers from them are cheaper)."""
+        columns = self.__dict__.get("_xyz")
+        if columns is None:
+            columns = tuple(np.ascontiguousarray(self.positions[:, k]) for k in range(3))
+            object.__setattr__(self, "_xyz", columns)
+        return columns
 
     def _grid_xy(self) -> "_CellGrid":
         grid = self.__dict__.get("_grid")

@@ -311,12 +311,18 @@ class ContactGenerator:
         near = np.nonzero(np.all((surfaces.bbox[:, 0, :2] - reach <= target_pos[:2]) &
                                  (surfaces.bbox[:, 1, :2] + reach >= target_pos[:2]), axis=1))[0]
         points, owner, rotations = [], [], []
+        disk_xy, disk = None, None  # the samples' (x, y) test is the same for every face
         for s in near:
             normal = surfaces.normals[s]
             # Vertical projection of the target on the face plane: itself a candidate.
             height = (surfaces.offsets[s] - normal[:2] @ target_pos[:2]) / normal[2]
             on_plane = np.array([target_pos[0], target_pos[1], height])
-            idx = db.near_column(root_R.T @ (on_plane - root_p), cfg.candidate_radius, cfg.candidate_slab)
+            local = root_R.T @ (on_plane - root_p)
+            xy = (float(local[0]), float(local[1]))
+            if xy != disk_xy:
+                disk_xy, disk = xy, db.near_disk(local, cfg.candidate_radius)
+            # = db.near_column(local, cfg.candidate_radius, cfg.candidate_slab)
+            idx = db.near_column_z(disk, local[2], cfg.candidate_slab)
             world = np.vstack([on_plane, root_p + db.positions[idx] @ root_R.T])
             # Database samples in a vertical column about the target, dropped vertically
             # on the face (reachability is re-checked exactly by IK below).

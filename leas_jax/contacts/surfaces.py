@@ -131,9 +131,10 @@ _BOUNDS_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _BOUND_MARGIN = 1e-3  # m, growth of the box footprints in `_height_bounds` (>> the terrain's 1e-7 m hit tolerance)
 
 
-def _box_bounds(terrain) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _box_bounds(terrain) -> tuple:
     """Per box, cached per terrain: xy footprint of its AABB grown by _BOUND_MARGIN [B, 2, 2],
-    top z [B], and whether it is tilted (roll or pitch) [B]."""
+    top z [B], whether it is tilted (roll or pitch) [B], and the footprints' columns
+    (`_footprint_columns`)."""
     if terrain not in _BOUNDS_CACHE:
         boxes = terrain.boxes
         aabb = np.array([box.aabb() for box in boxes]).reshape(-1, 2, 3)
@@ -142,8 +143,24 @@ def _box_bounds(terrain) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         # Yaw only, exactly: z axis (0, 0, 1) in both the box and the world frame.
         tilted = np.array([bool(np.any(box.rotation[2] != (0.0, 0.0, 1.0)) or np.any(box.rotation[:2, 2] != 0.0))
                            for box in boxes], dtype=bool)
-        _BOUNDS_CACHE[terrain] = (foot, top, tilted)
+        _BOUNDS_CACHE[terrain] = (foot, top, tilted, _footprint_columns(foot[:, 0], foot[:, 1]))
     return _BOUNDS_CACHE[terrain]
+
+
+def _footprint_columns(lo: np.ndarray, hi: np.ndarray) -> tuple:
+    """(x low, x high, y low, y high) [B] contiguous columns of footprints lo, hi [B, 2]."""
+    return tuple(np.ascontiguousarray(a[:, k]) for k in (0, 1) for a in (lo, hi))
+
+
+def _boxes_meeting(columns, xy: np.ndarray) -> np.ndarray:
+    """Sorted indices of the footprints (closed rectangles, `_footprint_columns` of them) that meet the
+    bounding rectangle of the points xy [N, 2]: a superset of those holding a point."""
+    x_lo, x_hi, y_lo, y_hi = columns
+    if len(xy) == 0:
+        return np.zeros(0, dtype=np.int64)
+    x0, y0 = xy.min(axis=0).tolist()
+    x1, y1 = xy.max(axis=0).tolist()
+    return np.flatnonzero((x_lo <= x1) & (x_hi >= x0) & (y_lo <= y1) & (y_hi >= y0))
 
 
 def _height_bounds(terrain, xy: np.ndarray) -> np.ndarray:
@@ -155,9 +172,12 @@ def _height_bounds(terrain, xy: np.ndarray) -> np.ndarray:
     So max(void, tops of the yaw-only boxes whose footprint holds the point) bounds the
     height, unless a tilted box's footprint holds the point (no cheap exact bound).
     """
-    foot, top, tilted = _box_bounds(terrain)
+    foot, top, tilted, columns = _box_bounds(terrain)
+    # Only the boxes whose footprint meets the points' bounding rectangle can hold one.
+    near = _boxes_meeting(columns, xy)
+    foot, top, tilted = foot[near], top[near], tilted[near]
     hit = ((xy[:, None, 0] >= foot[None, :, 0, 0]) & (xy[:, None, 0] <= foot[None, :, 1, 0]) &
-           (xy[:, None, 1] >= foot[None, :, 0, 1]) & (xy[:, None, 1] <= foot[None, :, 1, 1]))  # [N, B]
+           (xy[:, None, 1] >= foot[None, :, 0, 1]) & (xy[:, None, 1] <= foot[None, :, 1, 1]))  # [N, B']
     bound = np.maximum(np.max(np.where(hit, top[None, :], -np.inf), axis=1, initial=-np.inf),
                        float(terrain.void_height))
     return np.where(np.any(hit & tilted[None, :], axis=1), np.inf, bound)
@@ -166,10 +186,10 @@ def _height_bounds(terrain, xy: np.ndarray) -> np.ndarray:
 _HEIGHT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-def _column_bounds(terrain) -> tuple[np.ndarray, np.ndarray]:
+def _column_bounds(terrain) -> tuple:
     """Per box, cached per terrain: the xy window `Terrain.height_at` tests points against,
-    ([B, 2] low, [B, 2] high): the box AABB's footprint grown by the terrain's edge tolerance,
-    computed with the same operations (so the same float values)."""
+    ([B, 2] low, [B, 2] high, their `_footprint_columns`): the box AABB's footprint grown by
+    the terrain's edge tolerance, computed with the same operations (so the same float values)."""
     if terrain not in _HEIGHT_CACHE:
         from leas_jax.terrain.model import _EDGE_TOL
 
@@ -178,7 +198,8 @@ def _column_bounds(terrain) -> tuple[np.ndarray, np.ndarray]:
             box_lo, box_hi = box.aabb()[:, :2]
             lo.append(box_lo - _EDGE_TOL)
             hi.append(box_hi + _EDGE_TOL)
-        _HEIGHT_CACHE[terrain] = (np.array(lo).reshape(-1, 2), np.array(hi).reshape(-1, 2))
+        lo, hi = np.array(lo).reshape(-1, 2), np.array(hi).reshape(-1, 2)
+        _HEIGHT_CACHE[terrain] = (lo, hi, _footprint_columns(lo, hi))
     return _HEIGHT_CACHE[terrain]
 
 
@@ -192,13 +213,16 @@ def height_at(terrain, xy: np.ndarray) -> np.ndarray:
     the order, so the heights are identical.
     """
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    lo, hi = _column_bounds(terrain)
+    lo, hi, columns = _column_bounds(terrain)
+    near = _boxes_meeting(columns, xy)
+    lo, hi = lo[near], hi[near]
     x, y = xy[:, 0:1], xy[:, 1:2]
-    hit = (x >= lo[None, :, 0]) & (x <= hi[None, :, 0]) & (y >= lo[None, :, 1]) & (y <= hi[None, :, 1])  # [N, B]
+    hit = (x >= lo[None, :, 0]) & (x <= hi[None, :, 0]) & (y >= lo[None, :, 1]) & (y <= hi[None, :, 1])  # [N, B']
     top = np.full(len(xy), -np.inf)
     boxes = terrain.boxes
-    for b in np.flatnonzero(hit.any(axis=0)).tolist():
-        idx = np.flatnonzero(hit[:, b])
+    for k in np.flatnonzero(hit.any(axis=0)).tolist():
+        b = int(near[k])
+        idx = np.flatnonzero(hit[:, k])
         top[idx] = np.maximum(top[idx], boxes[b].column_top(xy[idx, 0], xy[idx, 1]))
     return np.where(np.isfinite(top), top, terrain.void_height)
 

@@ -249,13 +249,16 @@ class ContactGenerator:
                 # projection), the LP's robustness is < 0; rejected without the LP.
                 if -math.inf < margin < -_OUTSIDE_MARGIN and cfg.min_robustness >= 0.0:
                     return None
-                self.equilibrium.set_contacts(points, normals)
-                if self.equilibrium.robustness(com) < cfg.min_robustness:
-                    return None
+            # Every check must pass, so their order changes no result: cheapest first
+            # (terrain collision ~50 us, the LP ~300 us, self-collision ~100 us and rarely failing).
             rot, pos = self.robot.placements_fast(talos, root_R, root_p, leg_q)
             aabb = self.robot.world_aabb(rot, pos)
             if self.robot.terrain_contacts(rot, pos, self.terrain_objects, aabb=aabb):
                 return None
+            if margin < cfg.flat_com_margin:
+                self.equilibrium.set_contacts(points, normals)
+                if self.equilibrium.robustness(com) < cfg.min_robustness:
+                    return None
             if self.robot.self_contacts(rot, pos, aabb=aabb):
                 return None
             return _Posture(q=q, feet=feet, guide_index=guide_index)

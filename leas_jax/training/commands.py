@@ -29,8 +29,8 @@ def _add_training_arguments(parser) -> None:
     parser.add_argument("--init", metavar="RUN_DIR", default=None,
                         help="planner mode: fine-tune from this geometric run's latest checkpoint")
     parser.add_argument("--workers", type=int, default=None,
-                        help="planner mode: contact-generator worker processes (default: one per CPU minus one, "
-                             "at least 1; 0 plans in this process)")
+                        help="planner mode: contact-generator worker processes (default: one per CPU; "
+                             "0 plans in this process)")
     parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
                         help="planner mode: validate on this cluster instead of local processes")
     parser.add_argument("--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)")

@@ -8,6 +8,7 @@ validate batch k while JAX rolls out batch k+1.
 from __future__ import annotations
 
 import json
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -132,7 +133,7 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
             iterations of this call, to split a run; None trains to the end.
         field: a prebuilt `Heightfield`; default: built from `config.terrain`.
         workers: planner mode: contact-generator worker processes (None: one
-            per CPU minus one; 0: in this process).
+            per CPU; 0: in this process).
         address: planner mode: a validation backend address (e.g. a Ray
             cluster, see `leas_jax.contacts.pool.register_backend`).
         pool_options: planner mode: more `ValidationPool` keyword arguments
@@ -213,6 +214,9 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
         episodes = rollout(state, field, k_roll)
         return state.replace(key=key), episodes, k_update
 
+    # the learner mostly waits on validation: give the workers every core (the default)
+    if pool_options.get("workers") is None and pool_options.get("address") is None:
+        pool_options = {**pool_options, "workers": os.cpu_count() or 1}
     pool = ValidationPool(terrain, return_plans=False, **pool_options)
     try:
         state, episodes, k_update = draw(state)

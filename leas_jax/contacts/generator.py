@@ -350,10 +350,17 @@ class ContactGenerator:
         pos, owner = pos[keep], owner[keep]
         rot = np.stack(rotations)[np.searchsorted(near, owner)]
         ok = np.ones(len(pos), dtype=bool)
+        limit = 4 * cfg.max_candidates
         if avoid is not None and len(pos):
-            ok = ~self._overlaps(pos, rot, *avoid)
+            # Row-wise test, on a prefix first: only the closest `limit` passing ones are kept.
+            ok[:] = False
+            start = 0
+            while start < len(pos) and int(ok.sum()) < limit:
+                stop = min(len(pos), start + 2 * limit)
+                ok[start:stop] = ~self._overlaps(pos[start:stop], rot[start:stop], *avoid)
+                start = stop
         # The closest few go through the costlier tests.
-        ok[np.cumsum(ok) > 4 * cfg.max_candidates] = False
+        ok[np.cumsum(ok) > limit] = False
         return pos[ok], rot[ok]
 
     def _screen(self, side: int, guide_pose, pos, rot) -> np.ndarray:

@@ -233,7 +233,8 @@ class RobotCollision:
         if len(pairs):
             # Pairs whose oriented boxes (local bounds, which hold the meshes) are apart
             # cannot collide: coal would answer False; ~90 % of the pairs, ~5 us each.
-            pairs = pairs[~_obbs_apart(rot, pos, self.local_center, self.local_half, pairs[:, 0], pairs[:, 1])]
+            center = np.einsum("gij,gj->gi", rot, self.local_center) + pos
+            pairs = pairs[~_obbs_apart(rot, center, self.local_half, pairs[:, 0], pairs[:, 1])]
         hits = []
         request = coal.CollisionRequest()
         result = coal.CollisionResult()
@@ -247,45 +248,34 @@ class RobotCollision:
         return hits
 
 
-# Edge-edge axes A_i x B_j of the separating-axis test, and the cyclic successors of i, j.
-_SAT_I = np.repeat(np.arange(3), 3)
-_SAT_J = np.tile(np.arange(3), 3)
-_SAT_I1, _SAT_I2, _SAT_J1, _SAT_J2 = (_SAT_I + 1) % 3, (_SAT_I + 2) % 3, (_SAT_J + 1) % 3, (_SAT_J + 2) % 3
 # m, gap the test must see between two boxes to call them apart: far above the rounding
 # error of the test, far below any distance that matters (coal sees touching as contact).
 _SAT_MARGIN = 1e-6
 
 
-def _obbs_apart(rot, pos, local_center, local_half, a, b) -> np.ndarray:
+def _obbs_apart(rot, center, half, a, b) -> np.ndarray:
     """[P] whether geometry a[p]'s and b[p]'s oriented bounding boxes are apart by > _SAT_MARGIN.
 
-    Separating-axis test of two boxes (Gottschalk et al., "OBBTree", SIGGRAPH 1996): the
-    15 axes are the 3 + 3 face normals and the 9 edge-edge cross products, all in a's
-    frame (C = A^T B, t = A^T (c_b - c_a)). Conservative: an edge-edge axis is not
-    normalised (|A_i x B_j| <= 1, so its projected gap underestimates the true one) and
-    |C| is grown by 1e-12 (parallel edges give no false separation).
+    Separating-axis test of two boxes (Gottschalk et al., "OBBTree", SIGGRAPH 1996) on
+    the 3 + 3 face normals only, in a's frame (C = A^T B, t = A^T (c_b - c_a)); the 9
+    edge-edge axes would separate < 1 % more of the generator's pairs and cost as much
+    again. Conservative: missing axes only leave pairs to coal, and |C| is grown by 1e-12.
 
     Args:
-        rot: [G, 3, 3], pos: [G, 3] geometry placements, world.
-        local_center, local_half: [G, 3] geometry-frame bounding boxes.
+        rot: [G, 3, 3] geometry orientations, world.
+        center: [G, 3] world centres of the geometry-frame bounding boxes.
+        half: [G, 3] their half extents (geometry frame).
         a, b: [P] geometry indices of the pairs.
     """
     A, B = rot[a], rot[b]
-    ca = np.matmul(A, local_center[a, :, None])[:, :, 0] + pos[a]
-    cb = np.matmul(B, local_center[b, :, None])[:, :, 0] + pos[b]
-    ha, hb = local_half[a], local_half[b]
+    ha, hb = half[a], half[b]
     At = A.transpose(0, 2, 1)
     C = np.matmul(At, B)
-    t = np.matmul(At, (cb - ca)[:, :, None])[:, :, 0]
+    t = np.matmul(At, (center[b] - center[a])[:, :, None])[:, :, 0]
     absC = np.abs(C) + 1e-12
     apart = np.any(np.abs(t) - ha - np.matmul(absC, hb[:, :, None])[:, :, 0] > _SAT_MARGIN, axis=1)
     tb = np.matmul(t[:, None, :], C)[:, 0]
     apart |= np.any(np.abs(tb) - hb - np.matmul(ha[:, None, :], absC)[:, 0] > _SAT_MARGIN, axis=1)
-    i, j, i1, i2, j1, j2 = _SAT_I, _SAT_J, _SAT_I1, _SAT_I2, _SAT_J1, _SAT_J2
-    gap = np.abs(t[:, i2] * C[:, i1, j] - t[:, i1] * C[:, i2, j])
-    reach = (ha[:, i1] * absC[:, i2, j] + ha[:, i2] * absC[:, i1, j]
-             + hb[:, j1] * absC[:, i, j2] + hb[:, j2] * absC[:, i, j1])
-    apart |= np.any(gap - reach > _SAT_MARGIN, axis=1)
     return apart
 
 

@@ -219,3 +219,37 @@ def test_near_disk_and_column_match_near_column():
             column = db.near_column(point, radius, half)
             assert np.array_equal(column, brute)
             assert np.array_equal(db.near_column_z(db.near_disk(point, radius), point[2], half), brute)
+
+
+def legs_joint_frames_reference(hip_offset, thigh, shin, q):
+    """`collision._legs_joint_frames` before the speed-ups (one assignment per joint and entry)."""
+    c, s = np.cos(q), np.sin(q)
+    steps = np.zeros((2, 6, 4, 4))
+    steps[:, :, 3, 3] = 1.0
+    for k, axis in enumerate((2, 0, 1, 1, 1, 0)):
+        i, j = [(1, 2), (2, 0), (0, 1)][axis]
+        steps[:, k, axis, axis] = 1.0
+        steps[:, k, i, i] = c[:, k]
+        steps[:, k, j, j] = c[:, k]
+        steps[:, k, i, j] = -s[:, k]
+        steps[:, k, j, i] = s[:, k]
+    steps[:, 0, :3, 3] = hip_offset
+    steps[:, 3, 2, 3] = -thigh
+    steps[:, 4, 2, 3] = -shin
+    frames = np.empty((2, 6, 4, 4))
+    frames[:, 0] = steps[:, 0]
+    for k in range(1, 6):
+        frames[:, k] = frames[:, k - 1] @ steps[:, k]
+    return frames
+
+
+def test_legs_joint_frames_match(talos):
+    from leas_jax.contacts.collision import _legs_joint_frames
+
+    hip = np.array([leg.hip_offset for leg in talos.legs])
+    thigh = np.array([leg.thigh for leg in talos.legs])
+    shin = np.array([leg.shin for leg in talos.legs])
+    rng = np.random.default_rng(5)
+    for _ in range(500):
+        q = rng.uniform(-2.5, 2.5, (2, 6))
+        assert np.array_equal(_legs_joint_frames(hip, thigh, shin, q), legs_joint_frames_reference(hip, thigh, shin, q))

@@ -279,6 +279,12 @@ def _obbs_apart(rot, center, half, a, b) -> np.ndarray:
     return apart
 
 
+_STEP_K = np.arange(6)
+_STEP_AXIS = np.array([2, 0, 1, 1, 1, 0])  # joint axes of the leg chain z, x, y, y, y, x
+_STEP_I = np.array([[1, 2, 0][a] for a in _STEP_AXIS])
+_STEP_J = np.array([[2, 0, 1][a] for a in _STEP_AXIS])
+
+
 def _legs_joint_frames(hip_offset: np.ndarray, thigh: np.ndarray, shin: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Root-frame placements of both legs' six joint frames (after each joint's rotation).
 
@@ -292,13 +298,14 @@ def _legs_joint_frames(hip_offset: np.ndarray, thigh: np.ndarray, shin: np.ndarr
     c, s = np.cos(q), np.sin(q)
     steps = np.zeros((2, 6, 4, 4))
     steps[:, :, 3, 3] = 1.0
-    for k, axis in enumerate((2, 0, 1, 1, 1, 0)):
-        i, j = [(1, 2), (2, 0), (0, 1)][axis]
-        steps[:, k, axis, axis] = 1.0
-        steps[:, k, i, i] = c[:, k]
-        steps[:, k, j, j] = c[:, k]
-        steps[:, k, i, j] = -s[:, k]
-        steps[:, k, j, i] = s[:, k]
+    # Rotation about axis a of joint k: 1 at (a, a), cos at (i, i), (j, j), -sin at (i, j),
+    # sin at (j, i), with (i, j) the axes after a (index arrays _STEP_*: one assignment each).
+    k, axis, i, j = _STEP_K, _STEP_AXIS, _STEP_I, _STEP_J
+    steps[:, k, axis, axis] = 1.0
+    steps[:, k, i, i] = c
+    steps[:, k, j, j] = c
+    steps[:, k, i, j] = -s
+    steps[:, k, j, i] = s
     steps[:, 0, :3, 3] = hip_offset
     steps[:, 3, 2, 3] = -thigh
     steps[:, 4, 2, 3] = -shin

@@ -573,9 +573,16 @@ class ContactGenerator:
         def scores():
             return [self._lag_score(pose, side, *feet[side]) for side in (LEFT, RIGHT)]
 
-        keep = self._posture(pose, index, stance()) if self._comfortable(pose, stance()) else None
-        if keep is not None and max(scores()) <= 1.0:
-            return [keep]
+        # The posture keeping both contacts is built only when it is used: here if no foot
+        # lags, else after the steps, if none was possible (`_step` changes `feet` only when
+        # it succeeds, so `stance()` is then still the one of this point).
+        comfortable = self._comfortable(pose, stance())
+        keep = None
+        if comfortable and max(scores()) <= 1.0:
+            keep = self._posture(pose, index, stance())
+            if keep is not None:
+                return [keep]
+            comfortable = False  # built and failed: not again below
         added: list[_Posture] = []
         for _ in range(cfg.max_steps_per_pose):
             lag = scores()
@@ -588,6 +595,8 @@ class ContactGenerator:
                 break
             if self._comfortable(pose, stance()):
                 return added  # its last double-support posture stands at this pose
+        if not added and comfortable:
+            keep = self._posture(pose, index, stance())
         if not added and keep is not None:
             return [keep]  # no step possible but the stance still holds: step later
         return None

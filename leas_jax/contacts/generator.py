@@ -295,6 +295,17 @@ class ContactGenerator:
         keep = self._screen(side, guide_pose, pos, rot)
         return pos[keep], rot[keep]
 
+    def _first_candidate(self, side: int, guide_pose, target_pos, target_yaw: float, avoid=None):
+        """`candidates(...)`'s first placement (pos [3], rot [3, 3]), or None if it has none;
+        the pool is screened a few at a time (each entry passes or fails on its own)."""
+        pos, rot = self._candidate_pool(side, guide_pose, target_pos, target_yaw, avoid)
+        for start in range(0, len(pos), self._SCREEN_CHUNK):
+            chunk = slice(start, start + self._SCREEN_CHUNK)
+            keep = np.flatnonzero(self._screen(side, guide_pose, pos[chunk], rot[chunk]))
+            if len(keep):
+                return pos[start + keep[0]], rot[start + keep[0]]
+        return None
+
     def _candidate_pool(self, side: int, guide_pose, target_pos, target_yaw: float, avoid=None):
         """The ranked placements of `candidates` before the cover and reach tests.
 
@@ -514,10 +525,10 @@ class ContactGenerator:
         for side in (LEFT, RIGHT):
             target, yaw = self._nominal_placement(pose, side)
             avoid = feet[1 - side] if feet[1 - side] is not None else None
-            pos, rot = self.candidates(side, pose, target, yaw, avoid=avoid)
-            if len(pos) == 0:
+            first = self._first_candidate(side, pose, target, yaw, avoid)
+            if first is None:
                 return None
-            feet[side] = (pos[0], rot[0])
+            feet[side] = first
         contacts = [(side, feet[side][0], feet[side][1]) for side in (LEFT, RIGHT)]
         posture = self._posture(pose, 0, contacts)
         if posture is None:

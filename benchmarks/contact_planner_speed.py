@@ -8,6 +8,15 @@ root NOMINAL_ROOT_HEIGHT above the ground:
             omega_max = pi/9 rad/s (1.62 m of arc, radius 0.52 m), 1.19 m back;
   stairs    6 steps of 0.10 m (0.30 m treads), root z ramping up with the flight.
 
+  arena     24 guides of 200 poses on terrains/training_arena.toml (545 boxes), like
+            the guides planner-in-the-loop training validates (`arena_guides`): 12
+            random walks (speed and yaw rate re-drawn every pose, <= 0.3 m/s and
+            <= pi/9 rad/s), 12 straight lines or constant turns, all from seeded
+            NumPy, starting where the generator can stand; most fail part-way.
+            Reported as guide poses per CPU-second: all submitted guide poses
+            (4800) / CPU time of planning the 24 guides (the training's view: every
+            env step is a guide pose), and covered poses (up to last_valid_index).
+
 Targets: <= 50 ms per flat path, <= 5 ms per footstep on average over the three.
 The generator runs in-process; each guide is planned once to warm up (model,
 database, collision objects), then `--runs` times; best and median are reported.
@@ -17,7 +26,13 @@ counts; the load average is saved with them.
 BLAS/OpenMP pools are limited to one thread before NumPy is imported so that the
 figures are single-core ones. Writes results/contact_planner_speed.json.
 
-    python benchmarks/contact_planner_speed.py [--runs 20] [--profile flat]
+    python benchmarks/contact_planner_speed.py [--runs 20] [--cases flat,uturn,stairs,arena]
+        [--arena-runs 3] [--profile flat|uturn|stairs|arena]
+
+Plan identity across code changes: `--save-reference .cache/contact_parity/arena_reference.npz`
+stores the arena guides and the plans of all cases (q, feet, guide_index,
+last_valid_index, coverage); `--check-reference` re-plans and compares them exactly
+(tests/test_contacts_speed_parity.py does it too when the file exists).
 """
 
 from __future__ import annotations

@@ -219,9 +219,6 @@ class ContactGenerator:
             leg_q = self._legs_ik(root_R, root_p, contacts)
             if leg_q is None:
                 return None
-            feet = np.full((2, 7), np.nan)
-            for side, pos, rot in contacts:
-                feet[side] = _placement_row(pos, rot)
             if air is not None:
                 side, options = air
                 for pos, rot in options:
@@ -261,6 +258,9 @@ class ContactGenerator:
                     return None
             if self.robot.self_contacts(rot, pos, aabb=aabb):
                 return None
+            feet = np.full((2, 7), np.nan)  # built for an accepted posture only
+            for side, sole_pos, sole_rot in contacts:
+                feet[side] = _placement_row(sole_pos, sole_rot)
             return _Posture(q=q, feet=feet, guide_index=guide_index)
         return None
 

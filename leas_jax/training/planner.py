@@ -199,7 +199,8 @@ def training_batch(episodes: EpisodeBatch, last_valid_index: np.ndarray) -> tupl
 
     Returns:
         batch: dict of [N, T, ...] arrays for `update`.
-        stats: env_steps (alive steps), discarded_fraction, coverage inputs, episode returns.
+        stats: rolled_steps, kept_steps, discarded_fraction, episode_return (kept part),
+            episode_length, invalid_fraction (episodes ended by an invalid pose).
     """
     host = jax.device_get(episodes)
     mask, done, truncation = prune_after_failure(host.alive, host.done, host.truncation, host.guide_length,

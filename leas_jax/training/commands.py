@@ -119,8 +119,8 @@ def register(subparsers) -> None:
     _add_training_arguments(run)
     run.add_argument("--eval-episodes", type=_positive_int, default=256,
                      help="episodes per geometric evaluation metric (default 256)")
-    run.add_argument("--planner-steps", type=int, default=500_000,
-                     help="kept env steps of planner-in-the-loop fine-tuning (default 500 000; 0 skips it)")
+    run.add_argument("--planner-steps", type=int, default=150_000,
+                     help="kept env steps of planner-in-the-loop fine-tuning (default 150 000; 0 skips it; see docs/results for 500 000)")
     run.add_argument("--compare-starts", type=_positive_int, default=24,
                      help="starts per terrain for the before/after coverage comparison (default 24)")
     run.add_argument("--baseline-starts", type=_positive_int, default=10,

@@ -8,12 +8,12 @@ import json
 import re
 import shutil
 import subprocess
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
 
 from leas_jax.contacts import viewer
+from leas_jax.contacts.plan import ContactPlan
 
 # Ground x in [-1, 1.5], a hole for x in [1.5, 2], a step x in [2, 3] 0.1 m high.
 TERRAIN = """
@@ -32,21 +32,9 @@ size = [1.0, 2.0, 0.2]
 """
 
 
-@dataclass(frozen=True)
-class FakePlan:
-    """The DESIGN §6 plan attributes the viewers read."""
-
-    q: np.ndarray
-    feet: np.ndarray
-    guide_index: np.ndarray
-    last_valid_index: int
-    coverage: float
-    terrain: str
-    guide: np.ndarray
-
 
 @pytest.fixture(scope="module")
-def plan() -> FakePlan:
+def plan() -> ContactPlan:
     """Seven postures of Talos at half-sitting: left step, right step, left step.
 
     Sole rows come from Pinocchio forward kinematics of half-sitting (soles at
@@ -77,7 +65,7 @@ def plan() -> FakePlan:
         qs.append(q)
         feet.append(rows)
     guide = np.stack([np.linspace(0.0, 2.4, 25), np.zeros(25), np.full(25, 1.02), np.zeros(25)], axis=1)
-    return FakePlan(q=np.array(qs), feet=np.array(feet), guide_index=np.arange(7) * 2, last_valid_index=12,
+    return ContactPlan(q=np.array(qs), feet=np.array(feet), guide_index=np.arange(7) * 2, last_valid_index=12,
                     coverage=0.5, terrain=TERRAIN, guide=guide)
 
 
@@ -255,7 +243,7 @@ def test_footsteps_png_shows_feet_guide_and_failed_tail(plan, tmp_path):
 
 def test_empty_plan_still_renders(plan, tmp_path):
     # A generator that fails at the first pose returns no posture at all.
-    empty = FakePlan(q=np.zeros((0, 39)), feet=np.zeros((0, 2, 7)), guide_index=np.zeros(0, int),
+    empty = ContactPlan(q=np.zeros((0, 39)), feet=np.zeros((0, 2, 7)), guide_index=np.zeros(0, int),
                      last_valid_index=-1, coverage=0.0, terrain=TERRAIN, guide=plan.guide)
     assert viewer.footprints(empty) == [] and viewer.count_footsteps(empty) == 0
     viewer.write_html(empty, tmp_path / "v.html")

@@ -125,3 +125,26 @@ def test_argument_errors_exit_2(capsys, argv, fragment):
         main(argv)
     err = capsys.readouterr().err.strip()
     assert info.value.code == 2 and len(err.splitlines()) == 1 and fragment in err
+
+
+def test_rrt_searches_are_the_same_in_worker_processes():
+    """RRT searches are seeded and bounded by iterations: 2 spawned processes give the in-process plans."""
+    from leas_jax.env import EnvConfig, heightfield_from_terrain
+    from leas_jax.eval.evaluate import _rrt_plans
+    from leas_jax.eval.scenarios import Starts
+    from leas_jax.steering.baselines import BaselineConfig
+    from leas_jax.steering.rrt import RRTConfig
+    from leas_jax.terrain import loads_terrain
+
+    terrain, env = loads_terrain(WALL_SCENARIO), EnvConfig()
+    field = heightfield_from_terrain(terrain, env)
+    starts = Starts(np.array([[1.0, 1.0, 1.0, 0.0], [1.1, 0.9, 1.0, 0.2]]), np.array([0.0, 0.05]), np.zeros(2))
+    args = (terrain, env, starts, np.array([5.0, 1.0]), BaselineConfig.from_env(env),
+            RRTConfig(seed=3, max_iterations=400))
+    here = _rrt_plans(field, *args, workers=0, progress=False)
+    spawned = _rrt_plans(field, *args, workers=2, progress=False)
+    assert [p.success for p in here] == [p.success for p in spawned]
+    assert any(p.iterations > 1 for p in here)
+    for a, b in zip(here, spawned):
+        np.testing.assert_array_equal(a.states, b.states)
+        assert a.iterations == b.iterations

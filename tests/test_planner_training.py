@@ -123,3 +123,61 @@ def test_init_from_a_geometric_run(tmp_path):
     a, b = load_policy(tmp_path / "geo"), load_policy(tmp_path / "fine")
     for x, y in zip(jax.tree.leaves(a.params), jax.tree.leaves(b.params)):
         np.testing.assert_array_equal(x, y)
+
+
+def test_planner_learning_rate_decays_linearly_over_kept_steps():
+    from leas_jax.training.ppo import planner_learning_rate
+
+    config = tiny_planner_config(learning_rate=1e-3, num_timesteps=1000, learning_rate_schedule="linear")
+    assert float(planner_learning_rate(config, jnp.int32(0))) == pytest.approx(1e-3)
+    assert float(planner_learning_rate(config, jnp.int32(250))) == pytest.approx(7.5e-4)
+    assert float(planner_learning_rate(config, jnp.int32(5000))) == 0.0
+    constant = tiny_planner_config(learning_rate=1e-3, learning_rate_schedule="constant")
+    assert float(planner_learning_rate(constant, jnp.int32(5000))) == pytest.approx(1e-3)
+
+
+def test_planner_update_applies_the_scheduled_rate(tmp_path):
+    """Past the end of the linear schedule the rate is 0: the update moves no parameter."""
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.planner import make_planner_fns, training_batch
+
+    config = tiny_planner_config(num_timesteps=1000, learning_rate_schedule="linear")
+    field = heightfield_from_terrain(load_terrain(config.terrain_path()), config.env)
+    rollout, update = make_planner_fns(config)
+    state = init_state(config, field)
+    episodes = rollout(state, field, jax.random.PRNGKey(1))
+    batch, _ = training_batch(episodes, np.full(config.num_envs, 10_000))
+    moved, metrics = update(state, batch, jax.random.PRNGKey(2))
+    assert float(metrics["learning_rate"]) == pytest.approx(config.learning_rate)
+    assert any(not np.array_equal(a, b) for a, b in zip(jax.tree.leaves(state.params), jax.tree.leaves(moved.params)))
+    finished = state.replace(env_steps=jnp.int32(config.num_timesteps))
+    frozen, metrics = update(finished, batch, jax.random.PRNGKey(2))
+    assert float(metrics["learning_rate"]) == 0.0
+    for a, b in zip(jax.tree.leaves(state.params), jax.tree.leaves(frozen.params)):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_planner_preset_pretrains_a_geometric_policy_first(tmp_path, monkeypatch):
+    """Without --init, a planner config with `pretrain` trains that geometric preset in <out>/pretrain
+    and starts from it; a second call resumes instead of pretraining again."""
+    from leas_jax.training import config as config_module
+
+    monkeypatch.setitem(config_module.PRESETS, "tiny", dict(num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8,
+                                                           num_minibatches=2, num_epochs=1, iterations_per_call=2))
+    config = tiny_planner_config(pretrain="tiny", num_timesteps=1)
+    train(config, tmp_path / "run", progress=False, workers=0, stop_after_iterations=0)
+    pretrained = load_policy(tmp_path / "run" / "pretrain")
+    assert pretrained.config.mode == "geometric" and pretrained.config.seed == config.seed
+    for x, y in zip(jax.tree.leaves(pretrained.params), jax.tree.leaves(load_policy(tmp_path / "run").params)):
+        np.testing.assert_array_equal(x, y)
+    stamp = (tmp_path / "run" / "pretrain" / "metrics.jsonl").stat().st_mtime_ns
+    train(config, tmp_path / "run", progress=False, workers=0, stop_after_iterations=0)
+    assert (tmp_path / "run" / "pretrain" / "metrics.jsonl").stat().st_mtime_ns == stamp
+
+
+def test_unknown_pretrain_preset_is_rejected():
+    from leas_jax.errors import UsageError
+
+    with pytest.raises(UsageError, match="pretrain"):
+        tiny_planner_config(pretrain="nope")

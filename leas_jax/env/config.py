@@ -16,17 +16,25 @@ class ReachabilityConfig:
 
     DESIGN.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
     Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]: sensitivity
-    68.4 %, specificity 77.1 %). The defaults below are calibrated by
-    benchmarks/reachability_calibration.py: sensitivity 94.9 %, specificity 73.6 % on
-    12000 poses of terrains/training_arena.toml against the contact generator's
-    double-support posture (no cylinder setting reaches 90 % specificity at 95 %
-    sensitivity there; the sensitivity target came first).
+    68.4 %, specificity 77.1 %). benchmarks/reachability_calibration.py fitted the radii
+    and the leg band against the contact generator's *static* double-support posture
+    (sensitivity 94.9 %, specificity 73.6 % on 12000 poses of the training arena).
+
+    `trunk_bottom` is set by the *walking* generator instead: a static posture can
+    crouch to 0.53 m above the soles, but `plan_contacts` walks a straight guide only
+    with the root at least 0.90 m above flat ground (0.85 m: coverage 0.05), and on
+    the 0.12 m stairs of eval_stairs it needs about 1.0 m above the highest ground
+    within 0.15 m (benchmarks/walking_height.py). With -0.525, policies learnt to
+    climb stairs crouched 0.72-0.84 m above the step, where the generator fails;
+    -0.90 asks for the root 0.90 m above everything within the trunk radius, which
+    on stairs means rising before each step edge comes within 0.35 m.
     """
 
     # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)
     trunk_radius: float = 0.35
-    # m below the root: calibrated (DESIGN §5: -0.63, the hip); the generator crouches to ~0.53 m
-    trunk_bottom: float = -0.525
+    # m below the root: the walking generator's lowest root height over flat ground (see above;
+    # DESIGN §5: -0.63, the hip; static calibration: -0.525)
+    trunk_bottom: float = -0.90
     trunk_top: float = 0.60  # m above the root: head (no effect on a heightfield, which has no overhangs)
     # m, radius of each leg cylinder: calibrated (DESIGN §5: 0.25, talos_*leg_rom); the generator
     # needs ground near the nominal sole place, so a wide disk over-accepts

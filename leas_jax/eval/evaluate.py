@@ -111,17 +111,45 @@ def _baseline_guides(method: str, field, starts: Starts, points: np.ndarray, con
     return guides
 
 
-def _rrt_plans(field, terrain, starts: Starts, target, config, rrt_config, progress: bool) -> list:
+_RRT_FIELD = None  # the heightfield of an RRT worker process (built once by `_rrt_worker_start`)
+
+
+def _rrt_worker_start(terrain, env) -> None:
+    global _RRT_FIELD
+    from leas_jax.env import heightfield_from_terrain
+
+    _RRT_FIELD = heightfield_from_terrain(terrain, env)
+
+
+def _rrt_worker_plan(job):
+    from leas_jax.steering.rrt import plan_rrt
+
+    pose, target, speed, bounds, config, rrt, reach = job
+    return plan_rrt(_RRT_FIELD, pose, target, speed, bounds, config, rrt, reach)
+
+
+def _rrt_plans(field, terrain, env, starts: Starts, target, config, rrt_config, workers: int,
+               progress: bool) -> list:
+    """One RRT search per start (seed: rrt_config.seed + start index), in `workers` processes (0: here).
+
+    Each search is seeded and bounded by iterations (its wall-time bound is a safety net far
+    above them), so the plans do not depend on the number of processes.
+    """
     from tqdm.auto import tqdm
 
     from leas_jax.steering.rrt import plan_rrt
 
-    plans = []
-    for k, (pose, speed) in enumerate(tqdm(list(zip(starts.poses, starts.speeds)), desc="RBKino+RRT",
-                                           disable=not progress, leave=False)):
-        rrt = dataclasses.replace(rrt_config, seed=rrt_config.seed + k)
-        plans.append(plan_rrt(field, pose, target, float(speed), terrain.bounds, config, rrt))
-    return plans
+    jobs = [(pose, target, float(speed), terrain.bounds, config,
+             dataclasses.replace(rrt_config, seed=rrt_config.seed + k), env.reachability)
+            for k, (pose, speed) in enumerate(zip(starts.poses, starts.speeds))]
+    bar = dict(total=len(jobs), desc="RBKino+RRT", disable=not progress, leave=False)
+    if workers <= 0 or len(jobs) == 1:
+        return [plan_rrt(field, *job) for job in tqdm(jobs, **bar)]
+    import multiprocessing
+
+    with concurrent.futures.ProcessPoolExecutor(min(workers, len(jobs)), multiprocessing.get_context("spawn"),
+                                                initializer=_rrt_worker_start, initargs=(terrain, env)) as pool:
+        return list(tqdm(pool.map(_rrt_worker_plan, jobs), **bar))
 
 
 def _leas_guides(policy, field, starts: Starts, routes: list[np.ndarray], max_steps: int) -> list:
@@ -135,12 +163,19 @@ def _leas_guides(policy, field, starts: Starts, routes: list[np.ndarray], max_st
 
 
 def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, policy, n_starts: int,
-                       config, rrt_config, progress: bool = True) -> tuple[list[Trajectory], dict]:
+                       config, rrt_config, progress: bool = True, env=None,
+                       rrt_workers: int = 0) -> tuple[list[Trajectory], dict]:
     """Starts and guides of every cell and method of one scenario (no validation yet).
+
+    `env` (default: the policy's, else EnvConfig()) is what `field` was built with;
+    `rrt_workers` processes run the RRT searches (0: in this process).
 
     Returns:
         (trajectories, seconds spent per method building guides).
     """
+    from leas_jax.env import EnvConfig
+
+    env = env or (policy.config.env if policy is not None else EnvConfig())
     scenario = terrain.scenario
     points = route(scenario)
     target = np.asarray(scenario.target, np.float64)
@@ -165,7 +200,7 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
         plans = None
         if any(m in methods for m in RRT_METHODS):
             began = time.perf_counter()
-            plans = _rrt_plans(field, terrain, starts, target, config, rrt_config, progress)
+            plans = _rrt_plans(field, terrain, env, starts, target, config, rrt_config, rrt_workers, progress)
             seconds["rrt_search"] = seconds.get("rrt_search", 0.0) + time.perf_counter() - began
         if "rbkino_rrt" in methods:
             add("rbkino_rrt", [p.guide if p.success else None for p in plans],
@@ -199,8 +234,11 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
 
 
 def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: int, progress: bool = True,
-             desc: str = "contact planning") -> None:
-    """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`. Host-only."""
+             desc: str = "contact planning", address: str | None = None) -> None:
+    """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`. Host-only.
+
+    `address`: a Ray cluster for the pool (`ValidationPool(address=...)`); None for local processes.
+    """
     from tqdm.auto import tqdm
 
     from leas_jax.contacts.pool import ValidationPool
@@ -212,7 +250,7 @@ def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: 
             t.outcome = metrics.outcome(None, target, 0.0, -1, error=t.error or "no guide")
     if not todo:
         return
-    with ValidationPool(terrain, workers=workers, return_plans=True) as pool:
+    with ValidationPool(terrain, workers=workers, address=address, return_plans=True) as pool:
         futures = {pool.submit([t.guide], timestep): t for t in todo}
         with tqdm(total=len(todo), desc=desc, disable=not progress, leave=False) as bar:
             for future in concurrent.futures.as_completed(futures):
@@ -229,7 +267,7 @@ def default_workers() -> int:
 
 
 def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, workers: int, config=None,
-                 rrt_config=None, progress: bool = True) -> ScenarioResult:
+                 rrt_config=None, progress: bool = True, address: str | None = None) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
     Args:
@@ -242,6 +280,7 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
         config: `BaselineConfig` (default: from the policy's env, else the env defaults).
         rrt_config: `RRTConfig` (the seed of start k is its seed + k).
         progress: show progress bars.
+        address: a Ray cluster address for the contact generator (None: local processes).
     """
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
@@ -256,16 +295,18 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
     n = int(n_starts or terrain.scenario.n_starts)
     result = ScenarioResult(name, terrain, cells, tuple(methods))
     result.trajectories, result.seconds = build_trajectories(
-        name, terrain, field, cells, methods, policy, n, config, rrt_config or RRTConfig(), progress)
+        name, terrain, field, cells, methods, policy, n, config, rrt_config or RRTConfig(), progress, env,
+        rrt_workers=workers + 1 if workers else 0)
     began = time.perf_counter()
-    validate(terrain, result.trajectories, config.timestep, workers, progress, desc=f"{name}: contact planning")
+    validate(terrain, result.trajectories, config.timestep, workers, progress, desc=f"{name}: contact planning",
+             address=address)
     result.seconds["contact_planning"] = time.perf_counter() - began
     return result
 
 
 def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int | None = None,
              workers: int | None = None, terrain_file=None, progress: bool = True, rrt_config=None,
-             figures: bool = True) -> dict:
+             figures: bool = True, address: str | None = None) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
     Args:
@@ -274,11 +315,14 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
         checkpoint: run directory or policy.pkl (required by leas / leas_rrt).
         out: output directory (None: write nothing).
         n_starts: starts per cell (default each scenario table's).
-        workers: contact-generator processes (None: CPUs - 1; 0: in-process).
+        workers: contact-generator processes (None: CPUs - 1, or the Ray
+            cluster's CPUs with `address`; 0: in-process).
         terrain_file: any terrain file with a [scenario] table, run as one scenario.
         progress: progress bars.
         rrt_config: `RRTConfig`.
         figures: write PNG figures.
+        address: contact generator on a Ray cluster ("ray://HOST:PORT", "auto",
+            "local"; see `leas_jax.contacts.ray_backend`); None: local processes.
 
     Returns:
         the results dictionary written to results.json.
@@ -306,13 +350,14 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
             raise UsageError("--checkpoint is required by the methods leas and leas_rrt")
         from leas_jax.training.policy import load_policy
         policy = load_policy(checkpoint)
-    workers = default_workers() if workers is None else int(workers)
-    if workers < 0:
+    if workers is None and address is None:
+        workers = default_workers()  # on a Ray cluster, None: one actor per cluster CPU
+    if workers is not None and int(workers) < 0:
         raise UsageError(f"--workers: expected an integer >= 0, got {workers}")
     results = []
     for name, terrain in jobs:
         results.append(run_scenario(name, terrain, wanted[name], policy, n_starts, workers,
-                                    rrt_config=rrt_config, progress=progress))
+                                    rrt_config=rrt_config, progress=progress, address=address))
     report = tables.results_dict(results, policy=policy, seconds=time.perf_counter() - began)
     if out is not None:
         out = Path(out)

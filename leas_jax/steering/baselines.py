@@ -112,7 +112,8 @@ def lift_checked(field: Heightfield, planar, nominal_root_height: float,
     planar = np.asarray(planar, np.float64).reshape(-1, 3)
     padded, n = _padded(planar.astype(np.float32))
     poses, ok = _lift_valid(field, jnp.asarray(padded), float(nominal_root_height), config, bool(solid_ground))
-    z = np.asarray(poses[:n, 2], np.float64)
+    # to NumPy before slicing: slicing the jax array by a new `n` compiles a new XLA slice each time
+    z = np.asarray(poses, np.float64)[:n, 2]
     return np.column_stack([planar[:, 0], planar[:, 1], z, planar[:, 2]]), np.asarray(ok)[:n]
 
 

@@ -46,8 +46,10 @@ from leas_jax.steering.rbkino import min_time, sample_times, steer
 class RRTConfig:
     """Search settings of the kinodynamic RRT."""
 
-    max_iterations: int = 3000  # extensions (both trees together)
-    max_seconds: float = 30.0  # s of wall time
+    max_iterations: int = 3000  # extensions (both trees together): the budget (~15 s on one core here)
+    # s of wall time: a safety net only, far above the iteration budget, so that a search
+    # gives the same answer on a loaded machine (results must not depend on the load)
+    max_seconds: float = 300.0
     goal_bias: float = 0.05  # probability of sampling the other tree's root state
     sample_speed: float = 0.18  # m/s, sampled velocity norms in [0, this] (the target speed, paper §IV)
     sample_margin: float = 0.3  # m, positions are sampled this far inside the terrain bounds

@@ -22,12 +22,16 @@ def _add_training_arguments(parser) -> None:
     from leas_jax.training.config import PRESETS
 
     parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
-                        help="smoke (< 1 min), quick (80 M steps, 3 epochs, ~7 min on 2 cores), paper (80 M steps, 10 epochs)")
+                        help="geometric: smoke (< 1 min), quick (80 M steps, 3 epochs, ~10 min on 2 cores), "
+                             "paper (80 M steps, 10 epochs, ~25 min); planner: smoke (20 k kept steps from "
+                             "scratch), quick and paper (the geometric preset of the same name in "
+                             "<out>/pretrain, then 150 k / 600 k kept steps with the planner)")
     parser.add_argument("--mode", default="geometric", choices=["geometric", "planner"],
                         help="geometric: reachability condition only; planner: every episode validated by the "
                              "Talos contact generator (the paper's method)")
     parser.add_argument("--init", metavar="RUN_DIR", default=None,
-                        help="planner mode: fine-tune from this geometric run's latest checkpoint")
+                        help="planner mode: fine-tune from this geometric run's latest checkpoint "
+                             "(instead of the preset's own pretraining)")
     parser.add_argument("--workers", type=int, default=None,
                         help="planner mode: contact-generator worker processes (default: one per CPU; "
                              "0 plans in this process)")

@@ -51,8 +51,12 @@ class TrainConfig:
     # "geometric": PPO on the reachability condition alone; "planner": the paper's
     # method, every episode validated by the Talos contact generator (planner.py).
     mode: str = "geometric"
-    # planner mode: start from this geometric run's latest checkpoint ("" = scratch)
+    # planner mode: start from this geometric run's latest checkpoint ("" = see `pretrain`)
     init_from: str = ""
+    # planner mode without init_from: first train this geometric preset into
+    # <out>/pretrain and start from it ("" = from scratch). Not the paper's
+    # recipe (it validated every episode from the first); see PLANNER_PRESETS.
+    pretrain: str = ""
     terrain: str = "terrains/training_arena.toml"  # training terrain file
     num_timesteps: int = 60_000_000  # env steps in total
     num_envs: int = 2048
@@ -107,6 +111,9 @@ class TrainConfig:
         if self.learning_rate_schedule not in ("linear", "constant"):
             raise UsageError(f"TrainConfig.learning_rate_schedule must be 'linear' or 'constant', "
                              f"got {self.learning_rate_schedule!r}")
+        if self.pretrain and self.pretrain not in PRESETS:
+            raise UsageError(f"TrainConfig.pretrain must be '' or a geometric preset ({', '.join(PRESETS)}), "
+                             f"got {self.pretrain!r}")
         if self.num_envs % self.num_minibatches:
             raise UsageError(f"TrainConfig.num_envs ({self.num_envs}) must be a multiple of "
                              f"num_minibatches ({self.num_minibatches})")
@@ -148,16 +155,25 @@ PRESETS = {
 # Planner mode: an iteration is `num_envs` whole episodes (up to 400 steps),
 # every guide validated by the contact generator; `num_timesteps` counts the
 # steps kept after pruning. The budget is sized by the generator's speed
-# (benchmarks/planner_training_throughput.py).
+# (benchmarks/planner_training_throughput.py: a few thousand kept steps/s on
+# 2 cores at best, 700-4 000 in practice), so the paper's 80 M planner-validated
+# steps (53 h on 12 cores) would take days here. `quick` and `paper` therefore
+# start from a geometric policy (`pretrain`, the same 80 M steps of the
+# reachability condition alone) and fine-tune with the planner in the loop;
+# `smoke` trains from scratch. The learning rate decays linearly to 0 over the
+# kept steps (Stable Baselines' PPO1 default, as in the geometric presets); a
+# constant 5e-4 made a 500 k-step fine-tuning worse than a 150 k-step one
+# (docs/results/make-run-2026-11-22-planner-500k).
 PLANNER_PRESETS = {
     "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
-    "quick": dict(num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4),
-    "paper": dict(num_timesteps=80_000_000, num_envs=64, num_minibatches=4, num_epochs=10),
+    "quick": dict(num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick"),
+    "paper": dict(num_timesteps=600_000, num_envs=64, num_minibatches=4, num_epochs=10, pretrain="paper"),
 }
-# the number of planner iterations depends on how much the generator keeps, so
-# a schedule over "the whole run" is not known in advance: constant rate
-for _values in PLANNER_PRESETS.values():
-    _values["learning_rate_schedule"] = "constant"
+
+
+def pretraining_config(config: TrainConfig) -> TrainConfig:
+    """The geometric run a planner-mode `config` with `pretrain` starts from (same terrain, seed, env)."""
+    return preset(config.pretrain, mode="geometric", terrain=config.terrain, seed=config.seed, env=config.env)
 
 
 def preset(name: str, mode: str = "geometric", **overrides) -> TrainConfig:

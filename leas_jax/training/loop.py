@@ -19,7 +19,7 @@ import numpy as np
 
 from leas_jax.errors import LeasError, UsageError
 from leas_jax.training import checkpoint
-from leas_jax.training.config import TrainConfig, resolve_data_path
+from leas_jax.training.config import TrainConfig, pretraining_config, resolve_data_path
 from leas_jax.training.ppo import TrainState, init_state, make_train_call
 
 
@@ -127,6 +127,8 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
         config: training configuration (see `leas_jax.training.config.preset`);
             `config.mode` picks geometric or planner-in-the-loop PPO.
         out: run directory (created); an existing one with checkpoints resumes.
+            Planner mode with `config.pretrain` and no `init_from` first trains
+            (or resumes) that geometric preset in `out/pretrain`.
         progress: show a tqdm progress bar.
         on_log: called with every log record (also written to metrics.jsonl).
         stop_after_iterations: stop (with a checkpoint) after this many
@@ -155,11 +157,15 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
     if field is None:
         field = heightfield_from_terrain(terrain, config.env)
     found = checkpoint.list_checkpoints(run_dir)
+    init_from = config.init_from
+    if config.mode == "planner" and not init_from and config.pretrain and not found:
+        init_from = run_dir / "pretrain"
+        train(pretraining_config(config), init_from, progress=progress, field=field)
     state: TrainState = init_state(config, field)
     if found:
         state = jax.tree.map(jax.numpy.asarray, checkpoint.load_state(found[-1][1]))
-    elif config.init_from:
-        params, normalizer = initial_params_from(config.init_from)
+    elif init_from:
+        params, normalizer = initial_params_from(init_from)
         state = state.replace(params=jax.tree.map(jax.numpy.asarray, params),
                               normalizer=jax.tree.map(jax.numpy.asarray, normalizer))
     total = config.num_timesteps if config.mode == "planner" else config.num_iterations * config.batch_size

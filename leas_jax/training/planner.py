@@ -32,7 +32,7 @@ from leas_jax.env import LeasEnv
 from leas_jax.env.field import Heightfield
 from leas_jax.training.config import TrainConfig
 from leas_jax.training.networks import make_networks
-from leas_jax.training.ppo import TrainState, make_optimizer
+from leas_jax.training.ppo import TrainState, make_optimizer, planner_learning_rate, with_learning_rate
 
 
 @struct.dataclass
@@ -185,11 +185,13 @@ def make_planner_fns(config: TrainConfig):
             parts = jax.tree.map(lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
             return jax.lax.scan(minibatch, carry, (parts, jax.random.split(k_mb, config.num_minibatches)))
 
+        rate = planner_learning_rate(config, state.env_steps)
         (params, opt_state), metrics = jax.lax.scan(
-            epoch, (state.params, state.optimizer_state), jax.random.split(key, config.num_epochs))
+            epoch, (state.params, with_learning_rate(state.optimizer_state, rate)),
+            jax.random.split(key, config.num_epochs))
         state = state.replace(params=params, optimizer_state=opt_state, normalizer=normalizer,
                               env_steps=state.env_steps + kept.astype(jnp.int32), iteration=state.iteration + 1)
-        return state, {f"loss/{k}": v.mean() for k, v in metrics.items()}
+        return state, {**{f"loss/{k}": v.mean() for k, v in metrics.items()}, "learning_rate": rate}
 
     return jax.jit(rollout), jax.jit(update)
 

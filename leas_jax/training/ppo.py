@@ -58,13 +58,42 @@ class TrainState:
 
 
 def make_optimizer(config: TrainConfig) -> optax.GradientTransformation:
-    """Adam with global-norm clipping; the learning rate decays linearly to 0 over the run
-    when `learning_rate_schedule == "linear"` (counted in gradient steps)."""
+    """Adam with global-norm clipping.
+
+    Geometric mode: with `learning_rate_schedule == "linear"` the rate decays
+    linearly to 0 over the run, counted in gradient steps (the number of
+    iterations is fixed in advance). Planner mode keeps the rate in the
+    optimizer state (`optax.inject_hyperparams`): how many iterations a
+    budget of kept env steps takes depends on the contact generator, so the
+    update sets the rate from the kept steps instead (`planner_learning_rate`).
+    """
+    clip = optax.clip_by_global_norm(config.max_grad_norm)
+    if config.mode == "planner":
+        return optax.chain(clip, optax.inject_hyperparams(optax.adam)(learning_rate=config.learning_rate))
     rate = config.learning_rate
     if config.learning_rate_schedule == "linear":
         updates = config.num_iterations * config.num_epochs * config.num_minibatches
         rate = optax.linear_schedule(config.learning_rate, 0.0, updates)
-    return optax.chain(optax.clip_by_global_norm(config.max_grad_norm), optax.adam(rate))
+    return optax.chain(clip, optax.adam(rate))
+
+
+def planner_learning_rate(config: TrainConfig, env_steps: jax.Array) -> jax.Array:
+    """Planner mode: the learning rate after `env_steps` kept steps, float32[].
+
+    "linear" decays from `learning_rate` to 0 at `num_timesteps` kept steps
+    (Stable Baselines' PPO1 schedule, the paper's); "constant" keeps it.
+    """
+    if config.learning_rate_schedule == "constant":
+        return jnp.float32(config.learning_rate)
+    left = 1.0 - env_steps.astype(jnp.float32) / config.num_timesteps
+    return config.learning_rate * jnp.clip(left, 0.0, 1.0)
+
+
+def with_learning_rate(optimizer_state, rate: jax.Array):
+    """The planner-mode optimizer state (see `make_optimizer`) with its learning rate set to `rate`."""
+    clip_state, adam_state = optimizer_state
+    hyperparams = {**adam_state.hyperparams, "learning_rate": jnp.asarray(rate, jnp.float32)}
+    return clip_state, adam_state._replace(hyperparams=hyperparams)
 
 
 def init_state(config: TrainConfig, field: Heightfield) -> TrainState:

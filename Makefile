@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 RUN_NAME ?= quick
 JOBS ?= 2
 
-.PHONY: venv run test test-slow bench clean
+.PHONY: venv run test test-slow test-cluster bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +26,12 @@ test: $(STAMP)
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow
+
+# The Ray backend of the contact-plan validation (optional extra leas-jax[cluster]).
+test-cluster: $(STAMP)
+	$(PY) -m pip install -q -e '.[dev,cluster]'
+	$(PY) -m pip check
+	$(PY) -m pytest -q -m slow tests/test_ray_backend.py
 
 bench: $(STAMP)
 	$(PY) benchmarks/env_throughput.py

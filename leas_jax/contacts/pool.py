@@ -34,12 +34,13 @@ Design points (why):
   debuggers and profilers. An exception in the planner is still turned into an
   error result, but a crash of the planner takes the caller down with it.
   `workers >= 1` always uses subprocesses (one worker still isolates crashes).
-* `address=` is the hook for a remote cluster (DESIGN §7: "the same interface
-  accepts a Ray cluster address"). `address="ray://head:10001"` looks up the
-  backend registered for the scheme `ray` with `register_backend`; none ships
-  today (no Ray dependency). A backend receives a `WorkerSpec` and runs
-  `PathRunner(spec).run(...)` on its remote workers, so planning semantics
-  (seeding, error capture, result type) stay identical; see `register_backend`.
+* `address=` runs the workers on a cluster (DESIGN §7: "the same interface
+  accepts a Ray cluster address"): `address="ray://head:10001"`, `"auto"` or
+  `"local"` use the Ray backend of `leas_jax.contacts.ray_backend` (optional
+  extra `leas-jax[cluster]`; imported on first use). Other schemes look up a
+  backend registered with `register_backend`. A backend receives a
+  `WorkerSpec` and runs `PathRunner(spec).run(...)` on its remote workers, so
+  planning semantics (seeding, error capture, result type) stay identical.
 
 Test hook: `plan_fn=` replaces `plan_contacts` with any picklable module-level
 function of the same signature `(terrain, guide, timestep, config) -> plan`,
@@ -52,6 +53,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import importlib
 import itertools
 import math
 import multiprocessing
@@ -627,21 +629,17 @@ def _stop_workers(workers: list[_Worker]) -> None:
 # A remote backend factory: (address, spec, workers, options) -> Backend.
 BackendFactory = Callable[[str, WorkerSpec, "int | None", dict], Backend]
 _BACKENDS: dict[str, BackendFactory] = {}
+# Backends shipped with leas-jax: the module registers itself when imported, on first use.
+_BUILTIN_BACKENDS = {"ray": "leas_jax.contacts.ray_backend", "auto": "leas_jax.contacts.ray_backend",
+                     "local": "leas_jax.contacts.ray_backend"}
 
 
 def register_backend(scheme: str, factory: BackendFactory) -> None:
     """Register the executor used for `ValidationPool(address="<scheme>://...")`.
 
-    This is the hook for a Ray cluster (DESIGN §7). A Ray backend would be:
-
-        def ray_backend(address, spec, workers, options):
-            ray.init(address=address)
-            Actor = ray.remote(PathRunner)          # one PathRunner per actor
-            actors = [Actor.remote(spec) for _ in range(workers or n_cluster_cpus)]
-            ...  # submit(): round-robin actor.run.remote(i, guide, timestep, seed),
-                 # resolve a Future with the PathResults; an actor death
-                 # (RayActorError) retries the path once, like the local pool.
-        register_backend("ray", ray_backend)
+    The Ray backend (`leas_jax.contacts.ray_backend`, schemes "ray", "auto"
+    and "local") is registered this way when first used; it is the example to
+    follow for another executor.
 
     Args:
         scheme: the part of the address before "://" (or the whole address,
@@ -716,8 +714,9 @@ class ValidationPool:
             has a `seed` field, each path gets `path_seed(config.seed, index)`.
         plan_fn: None for `plan_contacts`; tests inject a picklable module-level
             function with the same signature (see module docstring).
-        address: None for local processes; "scheme://..." (e.g. a Ray address)
-            to use a backend registered with `register_backend`.
+        address: None for local processes; "ray://HOST:PORT", "auto" or
+            "local" for Ray actors (`leas_jax.contacts.ray_backend`); another
+            "scheme://..." for a backend registered with `register_backend`.
         task_timeout: s; a path running longer has its worker killed and is
             reported as an error. None: no limit.
         max_attempts: times a path is started when its worker dies under it.
@@ -748,11 +747,12 @@ class ValidationPool:
         self._backend: Backend
         if address is not None:
             scheme = address.split("://", 1)[0] if "://" in address else address
+            if scheme not in _BACKENDS and scheme in _BUILTIN_BACKENDS:
+                importlib.import_module(_BUILTIN_BACKENDS[scheme])
             factory = _BACKENDS.get(scheme)
             if factory is None:
-                hint = " (Ray support is not part of leas-jax yet)" if scheme in ("ray", "auto") else ""
-                raise UsageError(f"address={address!r}: no validation backend registered for scheme "
-                                 f"{scheme!r}{hint}; see leas_jax.contacts.pool.register_backend")
+                raise UsageError(f"address={address!r}: no validation backend for scheme {scheme!r} (Ray: "
+                                 "ray://HOST:PORT, auto or local); see leas_jax.contacts.pool.register_backend")
             options = dict(task_timeout=task_timeout, max_attempts=max_attempts,
                            max_tasks_per_worker=max_tasks_per_worker)
             self._backend = factory(address, spec, workers, options)

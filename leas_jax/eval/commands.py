@@ -42,7 +42,7 @@ def cmd_evaluate(args) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} exists and is not a directory")
     report = evaluate(scenarios, parse_methods(args.methods), args.checkpoint, out, args.n_starts, args.workers,
-                      terrain_file=args.terrain, progress=not args.no_progress)
+                      terrain_file=args.terrain, progress=not args.no_progress, address=args.ray_address)
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))
     for row in report["rows"]:
@@ -70,7 +70,12 @@ def register(subparsers) -> None:
     parser.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
                         help="starts per cell (default: the scenario table's n_starts, 60)")
     parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
-                        help="contact-generator processes (default CPUs - 1; 0: in-process)")
+                        help="contact-generator processes (default CPUs - 1; 0: in-process), or Ray actors "
+                             "with --ray-address (default: the cluster's CPUs)")
+    parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
+                        help="run the contact generator on Ray (pip install 'leas-jax[cluster]'): ray://HOST:PORT "
+                             "(Ray client of a cluster), auto (the cluster this machine belongs to) or local (a new "
+                             "local Ray instance)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.set_defaults(func=cmd_evaluate)

@@ -73,7 +73,7 @@ TARGET_SPECIFICITY = 0.90
 GRID = {
     "trunk_radius": (0.15, 0.20, 0.25, 0.30, 0.35, 0.40),
     "leg_radius": (0.05, 0.08, 0.10, 0.15, 0.20, 0.25, 0.30),
-    "trunk_bottom": tuple(np.round(np.arange(-0.40, -0.8001, -0.025), 3)),
+    "trunk_bottom": tuple(np.round(np.arange(-0.40, -0.9751, -0.025), 3)),
     "leg_bottom": tuple(np.round(np.arange(-1.05, -1.3001, -0.025), 3)),
     "leg_top": tuple(np.round(np.arange(-0.40, -0.7001, -0.025), 3)),
 }
@@ -135,20 +135,42 @@ def _init_worker(terrain_text: str) -> None:
     _WORKER["generator"] = ContactGenerator(loads_terrain(terrain_text, source="<calibration>"))
 
 
-def _feasible_chunk(poses: np.ndarray) -> np.ndarray:
+WALK_POSES = 21  # walking truth: guide poses 0.018 m apart (0.36 m in 2 s: two or three footsteps)
+WALK_SPEED = 0.18  # m/s, the target speed (paper §IV)
+WALK_TIMESTEP = 0.1  # s, paper Table I
+
+
+def walking_guide(pose: np.ndarray) -> np.ndarray:
+    """[WALK_POSES, 4] guide from `pose` straight ahead along its yaw at WALK_SPEED, same z and yaw."""
+    steps = np.arange(WALK_POSES) * WALK_SPEED * WALK_TIMESTEP
+    guide = np.repeat(np.asarray(pose, np.float64)[None], WALK_POSES, axis=0)
+    guide[:, 0] += steps * np.cos(pose[3])
+    guide[:, 1] += steps * np.sin(pose[3])
+    return guide
+
+
+def _feasible_one(generator, pose, truth: str) -> bool:
+    if truth == "static":
+        return generator.double_support(pose) is not None
+    return generator.plan(walking_guide(pose), WALK_TIMESTEP).coverage >= 1.0
+
+
+def _feasible_chunk(job) -> np.ndarray:
+    poses, truth = job
     generator = _WORKER["generator"]
-    return np.array([generator.double_support(pose) is not None for pose in poses], dtype=bool)
+    return np.array([_feasible_one(generator, pose, truth) for pose in poses], dtype=bool)
 
 
-def ground_truth(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100) -> np.ndarray:
-    """[N] whether the contact generator stands at each pose [N, 4] (double support).
+def ground_truth(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100, truth: str = "static") -> np.ndarray:
+    """[N] whether the contact generator stands at each pose [N, 4] (truth "static": a
+    double-support posture; "walking": a plan covering a short straight guide from it).
 
     Host-only. workers <= 1 runs in this process; otherwise a `spawn` pool (JAX may
     already hold threads here, which `fork` would copy half-initialised) with one
     ContactGenerator per worker; results keep the order of `poses`.
     """
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4)
-    chunks = [poses[k:k + chunk] for k in range(0, len(poses), chunk)]
+    chunks = [(poses[k:k + chunk], truth) for k in range(0, len(poses), chunk)]
     if workers <= 1:
         _init_worker(terrain.text)
         parts = [_feasible_chunk(c) for c in chunks]
@@ -186,26 +208,20 @@ def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: 
     import jax.numpy as jnp
 
     from leas_jax.env import EnvConfig, ReachabilityConfig
-    from leas_jax.env.field import Heightfield, disk_filter, sample_nearest
+    from leas_jax.env.field import heightfield_from_raster, sample_nearest
     from leas_jax.env.reachability import leg_centers
 
     config = ReachabilityConfig(trunk_radius=trunk_radius, leg_radius=leg_radius,
                                 leg_lateral_offset=leg_lateral_offset)
-    heights = np.asarray(terrain.raster(), dtype=np.float32)
-    res, void = terrain.resolution, terrain.void_height
-    f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
-    # Same rasters as heightfield_from_raster, without its spawn points (the grid
-    # visits radii that heightfield_from_raster might refuse for lack of spawns).
-    field = Heightfield(heights=f32(heights), trunk_max=f32(disk_filter(heights, trunk_radius / res, "max", void)),
-                        leg_max=f32(disk_filter(heights, leg_radius / res, "max", void)),
-                        leg_min=f32(disk_filter(heights, leg_radius / res, "min", void)),
-                        origin=f32(terrain.bounds[0]), resolution=f32(res), void_height=f32(void),
-                        spawn_xy=f32(np.zeros((1, 2))), spawn_spacing=f32(0.1))
+    # The environment's own rasters (the void is no floor for the legs); spawn points are
+    # not needed here, and the grid visits radii where there may be none.
+    field = heightfield_from_raster(terrain.raster(), terrain.bounds[0], terrain.resolution, terrain.void_height,
+                                    EnvConfig(reachability=config), require_spawn=False)
 
     def one(f, pose):
         legs = leg_centers(pose, config)
-        return (sample_nearest(f, f.trunk_max, pose[:2]), sample_nearest(f, f.leg_max, legs),
-                sample_nearest(f, f.leg_min, legs))
+        return (sample_nearest(f, f.trunk_max, pose[:2]), sample_nearest(f, f.leg_max, legs, outside=-jnp.inf),
+                sample_nearest(f, f.leg_min, legs, outside=jnp.inf))
 
     poses32 = jnp.asarray(poses, dtype=jnp.float32)
     trunk, leg_max, leg_min = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
@@ -362,6 +378,9 @@ def main(argv=None) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--terrain", default=str(ARENA))
     parser.add_argument("--reuse", action="store_true", help="reuse the cached ground truth if it matches")
+    parser.add_argument("--truth", choices=("static", "walking"), default="static",
+                        help="feasible = a double-support posture (static, the issue's definition) or a plan "
+                             "covering a 0.36 m straight guide from the pose (walking)")
     parser.add_argument("--baseline", default=None,
                         help="old defaults as 'trunk_radius,trunk_bottom,trunk_top,leg_radius,leg_bottom,leg_top' "
                              "(default: DESIGN §5 values)")
@@ -376,7 +395,8 @@ def main(argv=None) -> None:
         old = ReachabilityConfig(trunk_radius=tr, trunk_bottom=tb, trunk_top=tt, leg_radius=lr, leg_bottom=lb,
                                  leg_top=lt)
     poses = sample_poses(terrain, args.poses, args.seed)
-    cache = REPO / ".cache" / "reachability_ground_truth.npz"  # git-ignored
+    suffix = "" if args.truth == "static" else f"_{args.truth}"
+    cache = REPO / ".cache" / f"reachability_ground_truth{suffix}.npz"  # git-ignored
     truth, gt_seconds = None, None
     if args.reuse and cache.is_file():
         with np.load(cache) as data:
@@ -385,7 +405,7 @@ def main(argv=None) -> None:
                 print(f"reused the ground truth of {cache}")
     if truth is None:
         start = time.perf_counter()
-        truth = ground_truth(terrain, poses, args.workers)
+        truth = ground_truth(terrain, poses, args.workers, truth=args.truth)
         gt_seconds = time.perf_counter() - start
         cache.parent.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(cache, poses=poses, truth=truth, seconds=gt_seconds)
@@ -400,6 +420,8 @@ def main(argv=None) -> None:
     new = search["config"]
     old_figures, old_pred = figures(terrain, poses, truth, old, fit)
     new_figures, new_pred = figures(terrain, poses, truth, new, fit)
+    current = ReachabilityConfig()
+    current_figures, current_pred = figures(terrain, poses, truth, current, fit)
     # The NumPy thresholds of the search must agree with the jitted condition.
     samples = raster_samples(terrain, poses, new.trunk_radius, new.leg_radius, new.leg_lateral_offset)
     mismatch = int(np.sum(thresholds(samples, new.trunk_bottom, new.leg_bottom, new.leg_top) != new_pred))
@@ -413,7 +435,8 @@ def main(argv=None) -> None:
               f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {100 * row['sensitivity']:6.1f} "
               f"{100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
     print()
-    for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new", new, new_figures)):
+    for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new", new, new_figures),
+                           ("current EnvConfig defaults", current, current_figures)):
         print(f"{name}: trunk r {cfg.trunk_radius:.2f} [{cfg.trunk_bottom:+.3f}, {cfg.trunk_top:+.2f}], "
               f"legs r {cfg.leg_radius:.2f} [{cfg.leg_bottom:+.3f}, {cfg.leg_top:+.3f}]")
         for part in ("all", "fit", "held_out"):
@@ -423,7 +446,7 @@ def main(argv=None) -> None:
           f"{'met' if search['sensitive'] else 'NOT met'}); jitted/NumPy mismatches: {mismatch}")
 
     as_dict = lambda c: dataclasses.asdict(c)  # noqa: E731
-    save("reachability_calibration", {
+    save(f"reachability_calibration{suffix}", {"truth": args.truth,
         "terrain": str(Path(args.terrain).resolve().relative_to(REPO)) if Path(args.terrain).resolve().is_relative_to(REPO)
         else args.terrain,
         "poses": len(poses), "feasible": int(truth.sum()), "seed": args.seed, "workers": args.workers,
@@ -433,10 +456,12 @@ def main(argv=None) -> None:
         "targets": {"sensitivity": TARGET_SENSITIVITY, "specificity": TARGET_SPECIFICITY},
         "flat_ground_constraint": {"heights_m": FLAT_HEIGHTS, "margin_m": FLAT_MARGIN},
         "grid": {k: list(map(float, v)) for k, v in GRID.items()}, "candidates": search["candidates"],
-        "targets_met_on_fit": search["met"], "sensitivity_target_met_on_fit": search["sensitive"], "chosen": as_dict(new), "old": as_dict(old),
-        "figures": {"old": old_figures, "new": new_figures},
+        "targets_met_on_fit": search["met"], "sensitivity_target_met_on_fit": search["sensitive"],
+        "chosen": as_dict(new), "old": as_dict(old), "current": as_dict(current),
+        "figures": {"old": old_figures, "new": new_figures, "current": current_figures},
         "by_height_offset": {"old": breakdown(poses, truth, old_pred, terrain),
-                             "new": breakdown(poses, truth, new_pred, terrain)},
+                             "new": breakdown(poses, truth, new_pred, terrain),
+                             "current": breakdown(poses, truth, current_pred, terrain)},
         "best_per_radius_pair": search["table"], "jit_numpy_mismatches": mismatch,
     })
 

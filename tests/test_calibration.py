@@ -139,3 +139,18 @@ def test_sample_poses_seeded_and_in_range():
     # 30 % near the wall (the only obstacle): within 0.35 m + a cell of its footprint.
     near = (poses[:, 0] > 4.3 - 0.37) & (poses[:, 0] < 4.7 + 0.37)
     assert near.sum() >= 0.3 * 200
+
+
+def test_walking_truth_rejects_crouched_roots_the_static_truth_accepts():
+    """Talos stands crouched 0.6 m above the ground, but the generator does not walk that low."""
+    rng = np.random.default_rng(5)
+    crouched = np.column_stack([rng.uniform(1.0, 3.0, 3), rng.uniform(1.5, 4.5, 3), np.full(3, 0.6),
+                                rng.uniform(-math.pi, math.pi, 3)])
+    poses = np.concatenate([POSES[:3], crouched])
+    static = rc.ground_truth(TERRAIN, poses, workers=1)
+    walking = rc.ground_truth(TERRAIN, poses, workers=1, truth="walking")
+    np.testing.assert_array_equal(static, [True] * 6)
+    np.testing.assert_array_equal(walking, [True] * 3 + [False] * 3)
+    guide = rc.walking_guide(POSES[0])
+    assert guide.shape == (rc.WALK_POSES, 4)
+    np.testing.assert_allclose(np.hypot(*(guide[-1, :2] - guide[0, :2])), 0.36, atol=1e-9)

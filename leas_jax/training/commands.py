@@ -36,7 +36,9 @@ def _add_training_arguments(parser) -> None:
                         help="planner mode: contact-generator worker processes (default: one per CPU; "
                              "0 plans in this process)")
     parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
-                        help="planner mode: validate on this cluster instead of local processes")
+                        help="planner mode: validate on Ray instead of local processes (pip install "
+                             "'leas-jax[cluster]'): ray://HOST:PORT (Ray client of a cluster), auto (the cluster "
+                             "this machine belongs to) or local (a new local Ray instance)")
     parser.add_argument("--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)")
     parser.add_argument("--seed", type=int, default=None, help="PRNG seed (default: the preset's, 0)")
     parser.add_argument("--terrain", metavar="FILE", default=None,

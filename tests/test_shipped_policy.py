@@ -1,0 +1,44 @@
+"""The shipped policy `checkpoints/leas_talos/`: small, trained by the project's own preset, and it walks.
+
+If a default of the environment or of the presets changes, its config no longer
+equals the preset's and this fails: retrain it with the README's command.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from leas_jax.training import load_policy, preset
+from leas_jax.training.config import REPO_ROOT, pretraining_config
+
+SHIPPED = REPO_ROOT / "checkpoints" / "leas_talos"
+
+
+def _size(path: Path) -> int:
+    return sum(f.stat().st_size for f in path.rglob("*") if f.is_file())
+
+
+def test_shipped_policy_is_small_and_from_the_paper_preset():
+    assert _size(SHIPPED) < 5 * 2**20
+    policy = load_policy(SHIPPED)
+    assert policy.config == preset("paper", mode="planner")
+    assert policy.env_steps >= policy.config.num_timesteps
+    pretrained = load_policy(SHIPPED / "pretrain")
+    assert pretrained.config == pretraining_config(policy.config)
+    assert pretrained.env_steps >= pretrained.config.num_timesteps
+    # one full-state checkpoint per phase: `leas train` resumes (or fine-tunes with --init) from them
+    assert len(list((SHIPPED / "checkpoints").glob("step_*.pkl"))) == 1
+    assert len(list((SHIPPED / "pretrain" / "checkpoints").glob("step_*.pkl"))) == 1
+
+
+def test_shipped_policy_walks_to_a_target_with_a_contact_plan():
+    from leas_jax import load_terrain, rollout
+    from leas_jax.contacts import plan_contacts, verify
+
+    terrain = load_terrain(REPO_ROOT / "terrains" / "eval_ground.toml")
+    policy = load_policy(SHIPPED)
+    guide = rollout(policy, terrain, start=(4.0, 4.0, 0.0), target=(8.0, 4.0))
+    assert np.linalg.norm(guide[-1, :2] - [8.0, 4.0]) <= policy.config.env.target_reached_distance + 1e-6
+    plan = plan_contacts(terrain, guide, policy.config.env.timestep)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok

@@ -70,7 +70,7 @@ def register(subparsers) -> None:
     parser.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
                         help="starts per cell (default: the scenario table's n_starts, 60)")
     parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
-                        help="contact-generator processes (default CPUs - 1; 0: in-process), or Ray actors "
+                        help="contact-generator and RRT processes (default one per CPU; 0: in-process), or Ray actors "
                              "with --ray-address (default: the cluster's CPUs)")
     parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
                         help="run the contact generator on Ray (pip install 'leas-jax[cluster]'): ray://HOST:PORT "

@@ -262,8 +262,12 @@ def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: 
 
 
 def default_workers() -> int:
-    """Worker processes for the contact generator: CPUs - 1, at least 1."""
-    return max(1, (os.cpu_count() or 2) - 1)
+    """Processes for the contact generator and the RRT searches: one per CPU this process may use
+    (the main process only waits while they work)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
 
 
 def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, workers: int, config=None,
@@ -296,7 +300,7 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
     result = ScenarioResult(name, terrain, cells, tuple(methods))
     result.trajectories, result.seconds = build_trajectories(
         name, terrain, field, cells, methods, policy, n, config, rrt_config or RRTConfig(), progress, env,
-        rrt_workers=workers + 1 if workers else 0)
+        rrt_workers=workers or 0)
     began = time.perf_counter()
     validate(terrain, result.trajectories, config.timestep, workers, progress, desc=f"{name}: contact planning",
              address=address)
@@ -315,7 +319,7 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
         checkpoint: run directory or policy.pkl (required by leas / leas_rrt).
         out: output directory (None: write nothing).
         n_starts: starts per cell (default each scenario table's).
-        workers: contact-generator processes (None: CPUs - 1, or the Ray
+        workers: contact-generator and RRT processes (None: one per CPU, or the Ray
             cluster's CPUs with `address`; 0: in-process).
         terrain_file: any terrain file with a [scenario] table, run as one scenario.
         progress: progress bars.

@@ -115,6 +115,18 @@ def test_wall_stops_before_it():
     assert verify(plan).ok
 
 
+def test_narrow_bridge_crossed_on_its_centre_line():
+    """A 0.30 m bridge (the narrowest of the issue's 0.30-0.45 m): two soles side by side just fit."""
+    bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+                           + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    plan = plan_contacts(bridge, straight(0.0, 5.0), DT)
+    assert plan.coverage == 1.0
+    feet = plan.feet[:, :, :2][np.isfinite(plan.feet[:, :, 0])]
+    on_bridge = (feet[:, 0] > 2.1) & (feet[:, 0] < 3.9)
+    assert on_bridge.sum() >= 4 and np.abs(feet[on_bridge, 1]).max() <= 0.15 - 0.13 / 2
+    assert verify(plan).ok
+
+
 def test_hole_stops_before_it():
     hole = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([5, 0, -0.1], [4, 4, 0.2]))
     plan = plan_contacts(hole, straight(0.0, 4.0), DT)

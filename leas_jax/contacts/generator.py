@@ -72,9 +72,13 @@ class GeneratorConfig:
     candidate_slab: float = 0.10  # m, samples this close (vertically) to a face are dropped on it
     candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
     max_candidates: int = 12  # candidates tried per step (in rank order)
-    edge_margin: float = 0.01  # m, sole rectangle kept this far inside the face polygon
+    # m, sole rectangle kept this far inside the face polygon (DESIGN §6's 5 mm tolerance). Two
+    # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin: with 1 cm and 2 cm that was
+    # exactly the 0.30 m of eval_bridge, which no guide could cross: a centred straight guide at
+    # 0.18 m/s stopped 8 cm onto it (tests/test_contacts_generator.py crosses it now)
+    edge_margin: float = 0.005
     cover_tol: float = 0.005  # m, a sole is covered if the terrain rises more than this above it (DESIGN §6: 5 mm)
-    feet_gap: float = 0.02  # m, minimal gap between the two sole rectangles
+    feet_gap: float = 0.01  # m, minimal gap between the two sole rectangles (see edge_margin)
     swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
     min_robustness: float = 1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
     # m, on horizontal faces a CoM this far inside the support polygon is in equilibrium

@@ -35,6 +35,8 @@ def main() -> None:
     overrides = dict(num_timesteps=10**9, num_envs=args.num_envs)
     if args.init:
         overrides["init_from"] = args.init
+    else:
+        overrides["pretrain"] = ""  # from scratch, not the preset's geometric pretraining
     config = preset("quick", mode="planner", **overrides)
     records = []
     with tempfile.TemporaryDirectory() as out:

@@ -160,7 +160,10 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
     init_from = config.init_from
     if config.mode == "planner" and not init_from and config.pretrain and not found:
         init_from = run_dir / "pretrain"
-        train(pretraining_config(config), init_from, progress=progress, field=field)
+        pretrain = pretraining_config(config)
+        saved = checkpoint.list_checkpoints(init_from)
+        if not saved or saved[-1][0] < pretrain.num_iterations * pretrain.batch_size:  # else: finished
+            train(pretrain, init_from, progress=progress, field=field)
     state: TrainState = init_state(config, field)
     if found:
         state = jax.tree.map(jax.numpy.asarray, checkpoint.load_state(found[-1][1]))

@@ -370,7 +370,64 @@ def _describe_exit(exitcode: int | None) -> str:
     return f"exited with code {exitcode}"
 
 
-class _ProcessBackend:
+class _QueuedBackend:
+    """Job bookkeeping shared by the process and Ray backends.
+
+    `submit` queues one `_Task` per path of a `_Job`; the dispatcher thread
+    (`_thread`) hands tasks to workers and reports answers with `_complete`;
+    `_fail_jobs` fails every pending job. Subclasses create `_lock`, `_queue`,
+    `_live_jobs`, `_broken`, `_closing`, `_cancel` and `_thread`, and define
+    `_wake()` (interrupt the dispatcher's wait).
+    """
+
+    def submit(self, guides, timestep, seeds):
+        future: Future = Future()
+        future.set_running_or_notify_cancel()
+        if not guides:
+            future.set_result([])
+            return future
+        job = _Job(future=future, results=[None] * len(guides), remaining=len(guides))
+        with self._lock:
+            if self._broken is not None:
+                raise ValidationPoolError(f"the validation pool is broken: {self._broken}")
+            if self._closing:
+                raise ValidationPoolError("submit() on a closed ValidationPool")
+            self._live_jobs[id(job)] = job
+            for index, (guide, seed) in enumerate(zip(guides, seeds)):
+                self._queue.append(_Task(job=job, index=index, guide=guide, timestep=timestep, seed=seed))
+        self._wake()
+        return future
+
+    def close(self, cancel_pending=False):
+        with self._lock:
+            self._closing = True
+            self._cancel = self._cancel or cancel_pending
+        self._wake()
+        if threading.current_thread() is not self._thread:
+            self._thread.join()
+
+    def _complete(self, task: _Task, result: PathResult) -> None:
+        """Record one path's result (the first answer wins); resolve the job when it is whole."""
+        job = task.job
+        if job.results[task.index] is not None:
+            return
+        job.results[task.index] = result
+        job.remaining -= 1
+        if job.remaining == 0:
+            self._live_jobs.pop(id(job), None)
+            job.future.set_result(job.results)
+
+    def _fail_jobs(self, exc: BaseException) -> None:
+        """Fail every pending job with `exc`; later submits raise (caller holds the lock)."""
+        self._broken = exc
+        self._queue.clear()
+        for job in list(self._live_jobs.values()):
+            if not job.future.done():
+                job.future.set_exception(exc)
+        self._live_jobs.clear()
+
+
+class _ProcessBackend(_QueuedBackend):
     """Local worker processes driven by one dispatcher thread in the parent.
 
     The dispatcher owns all pipes and processes: it hands one task at a time to
@@ -404,33 +461,6 @@ class _ProcessBackend:
             self._spawn_missing()
         self._thread = threading.Thread(target=self._run, name="leas-validation-pool", daemon=True)
         self._thread.start()
-
-    # ---------------------------------------------------------------- public
-    def submit(self, guides, timestep, seeds):
-        future: Future = Future()
-        future.set_running_or_notify_cancel()
-        job = _Job(future=future, results=[None] * len(guides), remaining=len(guides))
-        if not guides:
-            future.set_result([])
-            return future
-        with self._lock:
-            if self._broken is not None:
-                raise ValidationPoolError(f"the validation pool is broken: {self._broken}")
-            if self._closing:
-                raise ValidationPoolError("submit() on a closed ValidationPool")
-            self._live_jobs[id(job)] = job
-            for index, (guide, seed) in enumerate(zip(guides, seeds)):
-                self._queue.append(_Task(job=job, index=index, guide=guide, timestep=timestep, seed=seed))
-        self._wake()
-        return future
-
-    def close(self, cancel_pending=False):
-        with self._lock:
-            self._closing = True
-            self._cancel = self._cancel or cancel_pending
-        self._wake()
-        if threading.current_thread() is not self._thread:
-            self._thread.join()
 
     # ---------------------------------------------------------------- dispatcher
     def _wake(self) -> None:
@@ -468,16 +498,6 @@ class _ProcessBackend:
                 # The worker died between its last message and now; its
                 # sentinel fires on the next wait and _on_death handles the task.
                 pass
-
-    def _complete(self, task: _Task, result: PathResult) -> None:
-        job = task.job
-        if job.results[task.index] is not None:
-            return
-        job.results[task.index] = result
-        job.remaining -= 1
-        if job.remaining == 0:
-            self._live_jobs.pop(id(job), None)
-            job.future.set_result(job.results)
 
     def _on_message(self, worker: _Worker, message) -> None:
         kind = message[0]
@@ -552,12 +572,7 @@ class _ProcessBackend:
 
     def _break(self, exc: BaseException) -> None:
         """Fail every pending job with `exc`; later submits raise (caller holds the lock)."""
-        self._broken = exc
-        self._queue.clear()
-        for job in list(self._live_jobs.values()):
-            if not job.future.done():
-                job.future.set_exception(exc)
-        self._live_jobs.clear()
+        self._fail_jobs(exc)
         for worker in self._pool:
             worker.task = None
 
@@ -651,13 +666,17 @@ def register_backend(scheme: str, factory: BackendFactory) -> None:
     _BACKENDS[scheme] = factory
 
 
+def available_cpus() -> int:
+    """CPUs this process may use (its affinity mask where the OS has one)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
+
+
 def _default_workers() -> int:
     """One worker per CPU this process may use, leaving one for the trainer."""
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except AttributeError:
-        cpus = os.cpu_count() or 1
-    return max(1, cpus - 1)
+    return max(1, available_cpus() - 1)
 
 
 def _terrain_spec(terrain, config, plan_fn, return_plans: bool) -> WorkerSpec:

@@ -48,12 +48,12 @@ import threading
 import time
 import traceback as traceback_module
 import warnings
-from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any
 
 from leas_jax.contacts.pool import (_MAX_STARTUP_DEATHS, _POLL_INTERVAL, PathResult, PathRunner,
-                                    ValidationPoolError, WorkerSpec, _Job, _one_line, _Task, register_backend)
+                                    ValidationPoolError, WorkerSpec, _Job, _one_line, _QueuedBackend, _Task,
+                                    register_backend)
 from leas_jax.errors import UsageError
 
 SCHEMES = ("ray", "auto", "local")
@@ -138,7 +138,7 @@ def _connect(ray, address: str, workers: int | None) -> None:
         raise RayAddressError(f"address={address!r}: cannot connect to Ray: {_one_line(exc)}{hint}") from None
 
 
-class RayBackend:
+class RayBackend(_QueuedBackend):
     """`Backend` on Ray actors, driven by one dispatcher thread (after start-up, all Ray calls happen there).
 
     Args:
@@ -163,7 +163,7 @@ class RayBackend:
         self._max_attempts = max_attempts
         self._max_tasks = max_tasks_per_worker
         self._lock = threading.RLock()  # re-entrant: a future's callback may call submit()
-        self._wake = threading.Event()
+        self._wake_event = threading.Event()
         self._queue: collections.deque[_Task] = collections.deque()
         self._live_jobs: dict[int, _Job] = {}
         self._actors: list[_Actor] = []
@@ -174,33 +174,10 @@ class RayBackend:
         self._thread.start()
 
     # ---------------------------------------------------------------- public
-    def submit(self, guides, timestep, seeds):
-        future: Future = Future()
-        future.set_running_or_notify_cancel()
-        if not guides:
-            future.set_result([])
-            return future
-        job = _Job(future=future, results=[None] * len(guides), remaining=len(guides))
-        with self._lock:
-            if self._broken is not None:
-                raise ValidationPoolError(f"the validation pool is broken: {self._broken}")
-            if self._closing:
-                raise ValidationPoolError("submit() on a closed ValidationPool")
-            self._live_jobs[id(job)] = job
-            for index, (guide, seed) in enumerate(zip(guides, seeds)):
-                self._queue.append(_Task(job=job, index=index, guide=guide, timestep=timestep, seed=seed))
-        self._wake.set()
-        return future
-
-    def close(self, cancel_pending=False):
-        with self._lock:
-            self._closing = True
-            self._cancel = self._cancel or cancel_pending
-        self._wake.set()
-        if threading.current_thread() is not self._thread:
-            self._thread.join()
-
     # ---------------------------------------------------------------- dispatcher
+    def _wake(self) -> None:
+        self._wake_event.set()
+
     def _kill(self, actor: _Actor) -> None:
         try:
             self._ray.kill(actor.handle, no_restart=True)
@@ -226,27 +203,12 @@ class RayBackend:
                     actor.tasks.append((task, actor.handle.run.remote(
                         task.index, task.guide, task.timestep, task.seed, task.attempts)))
 
-    def _complete(self, task: _Task, result: PathResult) -> None:
-        job = task.job
-        if job.results[task.index] is not None:
-            return
-        job.results[task.index] = result
-        job.remaining -= 1
-        if job.remaining == 0:
-            self._live_jobs.pop(id(job), None)
-            job.future.set_result(job.results)
-
     def _error(self, task: _Task, started: float, error: str) -> None:
         self._complete(task, PathResult(index=task.index, coverage=0.0, last_valid_index=-1, plan=None,
                                         error=error, attempts=task.attempts, seconds=time.monotonic() - started))
 
     def _break(self, exc: BaseException) -> None:
-        self._broken = exc
-        self._queue.clear()
-        for job in list(self._live_jobs.values()):
-            if not job.future.done():
-                job.future.set_exception(exc)
-        self._live_jobs.clear()
+        self._fail_jobs(exc)
         for actor in self._actors:
             self._kill(actor)
         self._actors.clear()
@@ -333,8 +295,8 @@ class RayBackend:
                         elif actor.tasks:
                             watched[actor.tasks[0][1]] = (actor, False)
                 if not watched:
-                    self._wake.wait(_POLL_INTERVAL)
-                    self._wake.clear()
+                    self._wake_event.wait(_POLL_INTERVAL)
+                    self._wake_event.clear()
                     continue
                 # Short waits: a submit() must reach idle actors quickly (ray.wait cannot be woken).
                 done, _ = ray.wait(list(watched), num_returns=1, timeout=0.05)

@@ -55,6 +55,8 @@ def cmd_evaluate(args) -> int:
 
 
 def register(subparsers) -> None:
+    from leas_jax.cli import add_ray_address_argument
+
     parser = subparsers.add_parser(
         "evaluate", help="baselines and LeaS on the paper's scenarios (Table II, Figs. 6-9)",
         description="Draw seeded starts from each scenario's [scenario] table, build guide paths with each steering "
@@ -72,10 +74,7 @@ def register(subparsers) -> None:
     parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
                         help="contact-generator and RRT processes (default one per CPU; 0: in-process), or Ray actors "
                              "with --ray-address (default: the cluster's CPUs)")
-    parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
-                        help="run the contact generator on Ray (pip install 'leas-jax[cluster]'): ray://HOST:PORT "
-                             "(Ray client of a cluster), auto (the cluster this machine belongs to) or local (a new "
-                             "local Ray instance)")
+    add_ray_address_argument(parser, "run the contact generator")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.set_defaults(func=cmd_evaluate)

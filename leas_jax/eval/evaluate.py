@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import concurrent.futures
 import dataclasses
-import os
 import time
 from dataclasses import dataclass, field as dataclass_field
 from pathlib import Path
@@ -264,10 +263,9 @@ def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: 
 def default_workers() -> int:
     """Processes for the contact generator and the RRT searches: one per CPU this process may use
     (the main process only waits while they work)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:
-        return max(1, os.cpu_count() or 1)
+    from leas_jax.contacts.pool import available_cpus
+
+    return available_cpus()
 
 
 def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, workers: int, config=None,

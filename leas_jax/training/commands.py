@@ -19,6 +19,7 @@ def _positive_int(text: str) -> int:
 
 
 def _add_training_arguments(parser) -> None:
+    from leas_jax.cli import add_ray_address_argument
     from leas_jax.training.config import PRESETS
 
     parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
@@ -35,10 +36,7 @@ def _add_training_arguments(parser) -> None:
     parser.add_argument("--workers", type=int, default=None,
                         help="planner mode: contact-generator worker processes (default: one per CPU; "
                              "0 plans in this process)")
-    parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
-                        help="planner mode: validate on Ray instead of local processes (pip install "
-                             "'leas-jax[cluster]'): ray://HOST:PORT (Ray client of a cluster), auto (the cluster "
-                             "this machine belongs to) or local (a new local Ray instance)")
+    add_ray_address_argument(parser, "planner mode: validate the guides")
     parser.add_argument("--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)")
     parser.add_argument("--seed", type=int, default=None, help="PRNG seed (default: the preset's, 0)")
     parser.add_argument("--terrain", metavar="FILE", default=None,

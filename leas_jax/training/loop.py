@@ -8,7 +8,6 @@ validate batch k while JAX rolls out batch k+1.
 from __future__ import annotations
 
 import json
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -210,7 +209,7 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
     A batch in flight when the run stops is dropped (it is re-drawn on
     resume from the saved PRNG key); only updated states are checkpointed.
     """
-    from leas_jax.contacts.pool import ValidationPool
+    from leas_jax.contacts.pool import ValidationPool, available_cpus
     from leas_jax.training.planner import guides_of, make_planner_fns
 
     rollout, update = make_planner_fns(config)
@@ -225,7 +224,7 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
 
     # the learner mostly waits on validation: give the workers every core (the issue's default)
     if pool_options.get("workers") is None and pool_options.get("address") is None:
-        pool_options = {**pool_options, "workers": os.cpu_count() or 1}
+        pool_options = {**pool_options, "workers": available_cpus()}
     pool = ValidationPool(terrain, return_plans=False, **pool_options)
     try:
         state, episodes, k_update = draw(state)

@@ -1,6 +1,7 @@
 """Contact generator: coverage on feasible guides, failure before obstacles, plan format."""
 
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -192,3 +193,17 @@ def test_config_is_frozen_and_used():
     generator = ContactGenerator(FLAT, config)
     plan = generator.plan(straight(0.0, 1.0), DT)
     assert set(np.unique(plan.guide_index)) <= set(range(0, len(plan.guide), 10)) | {len(plan.guide) - 1}
+
+
+def test_slow_leas_climb_of_eval_stairs_is_covered():
+    """A guide of the shipped policy on eval_stairs (start 1.82, 3.87, yaw 0.18 rad; up to
+    the top platform): it climbs at ~0.06 m/s with its root rising tread by tread. With a
+    0.10 m step trigger the trailing foot stayed a tread lower until its leg was
+    overstretched, and the plan stopped at 69 % of the guide."""
+    from leas_jax.eval.scenarios import scenario_file
+    from leas_jax.terrain import load_terrain
+
+    data = np.load(Path(__file__).parent / "data" / "eval_stairs_slow_leas_guide.npz")
+    plan = plan_contacts(load_terrain(scenario_file("stairs")), data["guide"], float(data["timestep"]))
+    assert plan.coverage == 1.0
+    assert verify(plan).ok

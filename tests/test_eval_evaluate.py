@@ -148,3 +148,15 @@ def test_rrt_searches_are_the_same_in_worker_processes():
     for a, b in zip(here, spawned):
         np.testing.assert_array_equal(a.states, b.states)
         assert a.iterations == b.iterations
+
+
+def test_leas_horizon_scales_with_the_route_and_keeps_the_minimum():
+    from leas_jax.eval.scenarios import HORIZON_FACTOR, leas_horizon
+
+    # 6 m at 0.18 m/s and 0.1 s per step: 333.3 steps at the target speed.
+    points = np.array([[6.0, 0.0]])
+    assert leas_horizon([0.0, 0.0], points, 0.18, 0.1, 400) == int(np.ceil(HORIZON_FACTOR * 6.0 / 0.018))
+    assert leas_horizon([0.0, 0.0], points, 0.18, 0.1, 400, factor=1.0) == 400  # the minimum wins
+    # a polyline counts its whole length: 3 m + 4 m
+    route = np.array([[3.0, 0.0], [3.0, 4.0]])
+    assert leas_horizon([0.0, 0.0], route, 0.18, 0.1, 0, factor=1.0) == int(np.ceil(7.0 / 0.018))

@@ -28,6 +28,13 @@ trunk cylinder is free iff the terrain under it stays below its bottom. The old 
 the chosen defaults are also evaluated with `reachability.valid` itself on
 `heightfield_from_terrain(terrain, EnvConfig(reachability=cfg))`, and must agree.
 
+Optional terms (issue 3 item 6, benchmarks/reachability_false_positives.py): a second
+search (`TERMS_GRID`) adds the lookahead leg cylinders (`leg_forward`) and the foothold
+flatness term (`foothold_radius`, `foothold_search`, `foothold_spread`) of
+`leas_jax.env.reachability` to the thresholds above, on fewer radii (they cost a
+raster per setting); both bests are reported, and the NumPy form of each is checked
+against the jitted condition.
+
 Selection: parameters that keep a root at 1.0 m and at NOMINAL_ROOT_HEIGHT (1.019 m)
 above flat ground valid with >= 2 cm margins (the environment's spawn logic needs it);
 among those with sensitivity >= 95 % and specificity >= 90 % on the fitting two
@@ -35,7 +42,8 @@ thirds of the poses, the largest Youden index (sensitivity + specificity - 1); i
 meets both, the best specificity among those with sensitivity >= 95 %; if none, the
 largest Youden index. Near-ties go to the closest to the old defaults. Figures are
 reported on the held-out third and on all poses. Writes results/reachability_calibration.json (and caches the ground truth in
-.cache/reachability_ground_truth.npz at the repository root, reused with --reuse).
+.cache/reachability_ground_truth[_walking].npz at the repository root, reused with --reuse when the
+poses and the fingerprint of the contact generator's sources, leas_jax/contacts/*.py, match).
 
     python benchmarks/reachability_calibration.py [--poses 12000] [--workers 2] [--reuse]
 """
@@ -49,6 +57,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
+import hashlib  # noqa: E402
 import itertools  # noqa: E402
 import multiprocessing  # noqa: E402
 import sys  # noqa: E402
@@ -69,13 +78,26 @@ FLAT_MARGIN = 0.02  # m, margin those must keep from every threshold
 TARGET_SENSITIVITY = 0.95
 TARGET_SPECIFICITY = 0.90
 
-# Grid of the search (m). trunk_top is not searched: no effect on a heightfield.
+# Grid of the search (m). trunk_top is not searched: no effect on a heightfield. leg_top goes
+# down to -0.95 (it stopped at -0.70 before issue 3 item 6): with the walking truth the
+# lowest ground under a leg must be ~0.9 m below the root, and -0.95 still keeps the
+# flat-ground margins (FLAT_MARGIN).
 GRID = {
     "trunk_radius": (0.15, 0.20, 0.25, 0.30, 0.35, 0.40),
     "leg_radius": (0.05, 0.08, 0.10, 0.15, 0.20, 0.25, 0.30),
     "trunk_bottom": tuple(np.round(np.arange(-0.40, -0.9751, -0.025), 3)),
     "leg_bottom": tuple(np.round(np.arange(-1.05, -1.3001, -0.025), 3)),
-    "leg_top": tuple(np.round(np.arange(-0.40, -0.7001, -0.025), 3)),
+    "leg_top": tuple(np.round(np.arange(-0.40, -0.9501, -0.025), 3)),
+}
+# Grid of the optional terms, searched with the thresholds of GRID on fewer radii (the two
+# trunk radii the search above prefers, the smallest leg radius). foothold: None (off) or
+# (foothold_radius, foothold_search) in m, each with every foothold_spread (m).
+TERMS_GRID = {
+    "trunk_radius": (0.20, 0.30),
+    "leg_radius": (0.05,),
+    "leg_forward": (0.0, 0.06, 0.12, 0.18, 0.24),
+    "foothold": (None, (0.065, 0.10), (0.08, 0.10), (0.10, 0.10)),
+    "foothold_spread": (0.01, 0.02, 0.04),
 }
 
 
@@ -181,6 +203,45 @@ def ground_truth(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100,
     return np.concatenate(parts) if parts else np.zeros(0, dtype=bool)
 
 
+def generator_fingerprint(truth: str) -> str:
+    """sha256 of the contact generator's sources (leas_jax/contacts/*.py) and of the truth's
+    settings: a cached ground truth is reused only if nothing it depends on changed."""
+    digest = hashlib.sha256(f"{truth} {WALK_POSES} {WALK_SPEED} {WALK_TIMESTEP}".encode())
+    for path in sorted((REPO / "leas_jax" / "contacts").glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def cache_path(truth: str) -> Path:
+    """.cache/reachability_ground_truth[_<truth>].npz at the repository root (git-ignored)."""
+    suffix = "" if truth == "static" else f"_{truth}"
+    return REPO / ".cache" / f"reachability_ground_truth{suffix}.npz"
+
+
+def cached_ground_truth(terrain, poses: np.ndarray, truth: str = "static", workers: int = 2,
+                        reuse: bool = True) -> tuple[np.ndarray, float]:
+    """`ground_truth` of poses [N, 4], from the cache when `reuse` and it holds the same poses
+    and generator fingerprint; otherwise computed and cached. Returns (truth [N] bool,
+    seconds it took to compute)."""
+    cache = cache_path(truth)
+    fingerprint = generator_fingerprint(truth)
+    if reuse and cache.is_file():
+        with np.load(cache) as data:
+            same_poses = data["poses"].shape == poses.shape and np.array_equal(data["poses"], poses)
+            same_generator = "generator" in data.files and str(data["generator"]) == fingerprint
+            if same_poses and same_generator:
+                print(f"reused the ground truth of {cache}")
+                return data["truth"], float(data["seconds"])
+            print(f"not reusing {cache}: " + ("the contact generator changed" if same_poses else "other poses"))
+    start = time.perf_counter()
+    result = ground_truth(terrain, poses, workers, truth=truth)
+    seconds = time.perf_counter() - start
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(cache, poses=poses, truth=result, seconds=seconds, generator=fingerprint)
+    return result, seconds
+
+
 # ------------------------------------------------------------------ condition
 
 def condition(terrain, poses: np.ndarray, config) -> np.ndarray:
@@ -197,44 +258,58 @@ def condition(terrain, poses: np.ndarray, config) -> np.ndarray:
 
 
 def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: float,
-                   leg_lateral_offset: float) -> dict:
-    """What the condition reads, per pose, for one pair of radii (jitted, vmapped).
+                   leg_lateral_offset: float, leg_forward: float = 0.0, foothold=None) -> dict:
+    """What the condition reads, per pose, for one set of radii (jitted, vmapped).
+
+    Args:
+        terrain: a leas_jax.terrain.Terrain; poses: [N, 4] (x, y, z, yaw), world.
+        trunk_radius, leg_radius, leg_lateral_offset, leg_forward: ReachabilityConfig fields, m.
+        foothold: None (term off) or (foothold_radius, foothold_search), m.
 
     Returns:
         dict of float32 arrays: z [N], trunk [N] (trunk_max at the root), leg_max and
-        leg_min [N, 2] (at the left and right leg centres).
+        leg_min [N, L] (at the leg centres of `reachability.all_leg_centers`: left, right,
+        then left and right ahead when leg_forward != 0, L = 2 or 4) and, with the
+        foothold term, foothold [N, L] (the foothold raster at those centres).
     """
     import jax
     import jax.numpy as jnp
 
     from leas_jax.env import EnvConfig, ReachabilityConfig
     from leas_jax.env.field import heightfield_from_raster, sample_nearest
-    from leas_jax.env.reachability import leg_centers
+    from leas_jax.env.reachability import all_leg_centers
 
+    extra = {} if foothold is None else {"foothold_radius": foothold[0], "foothold_search": foothold[1],
+                                         "foothold_spread": 0.0}  # any value: builds the raster
     config = ReachabilityConfig(trunk_radius=trunk_radius, leg_radius=leg_radius,
-                                leg_lateral_offset=leg_lateral_offset)
+                                leg_lateral_offset=leg_lateral_offset, leg_forward=leg_forward, **extra)
     # The environment's own rasters (the void is no floor for the legs); spawn points are
     # not needed here, and the grid visits radii where there may be none.
     field = heightfield_from_raster(terrain.raster(), terrain.bounds[0], terrain.resolution, terrain.void_height,
                                     EnvConfig(reachability=config), require_spawn=False)
 
     def one(f, pose):
-        legs = leg_centers(pose, config)
+        legs = all_leg_centers(pose, config)
         return (sample_nearest(f, f.trunk_max, pose[:2]), sample_nearest(f, f.leg_max, legs, outside=-jnp.inf),
-                sample_nearest(f, f.leg_min, legs, outside=jnp.inf))
+                sample_nearest(f, f.leg_min, legs, outside=jnp.inf),
+                sample_nearest(f, f.foothold, legs, outside=jnp.inf) if foothold is not None else jnp.zeros(0))
 
     poses32 = jnp.asarray(poses, dtype=jnp.float32)
-    trunk, leg_max, leg_min = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
-    return {"z": np.asarray(poses32[:, 2]), "trunk": np.asarray(trunk), "leg_max": np.asarray(leg_max),
-            "leg_min": np.asarray(leg_min)}
+    trunk, leg_max, leg_min, flat = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
+    out = {"z": np.asarray(poses32[:, 2]), "trunk": np.asarray(trunk), "leg_max": np.asarray(leg_max),
+           "leg_min": np.asarray(leg_min)}
+    if foothold is not None:
+        out["foothold"] = np.asarray(flat)
+    return out
 
 
-def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top) -> np.ndarray:
+def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top, foothold_spread=None) -> np.ndarray:
     """The condition of `reachability.terms` from `raster_samples`, for many thresholds at once.
 
     Args:
-        samples: raster_samples output (N poses).
+        samples: raster_samples output (N poses, L leg centres).
         trunk_bottom, leg_bottom, leg_top: [...] broadcastable threshold arrays, m.
+        foothold_spread: None (term off) or a scalar, m (needs samples["foothold"]).
 
     Returns:
         [..., N] bool (float32 arithmetic, as in the jitted condition).
@@ -242,10 +317,12 @@ def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top) -> np.ndarray:
     z = samples["z"]
     f = np.float32
     tb, lb, lt = (np.asarray(v, dtype=f)[..., None] for v in (trunk_bottom, leg_bottom, leg_top))
-    trunk_free = samples["trunk"] < z + tb
-    touch = ((samples["leg_max"][:, 0] >= z + lb) & (samples["leg_min"][:, 0] <= z + lt) &
-             (samples["leg_max"][:, 1] >= z + lb) & (samples["leg_min"][:, 1] <= z + lt))
-    return trunk_free & touch
+    result = samples["trunk"] < z + tb
+    for k in range(samples["leg_max"].shape[1]):  # every leg cylinder touches
+        result = result & (samples["leg_max"][:, k] >= z + lb) & (samples["leg_min"][:, k] <= z + lt)
+    if foothold_spread is not None:
+        result = result & np.all(samples["foothold"] <= f(foothold_spread), axis=1)
+    return result
 
 
 def confusion(predicted: np.ndarray, truth: np.ndarray) -> dict:
@@ -285,54 +362,78 @@ def flat_ground_ok(trunk_bottom, leg_bottom, leg_top, heights=FLAT_HEIGHTS, marg
 # ------------------------------------------------------------------ search
 
 def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, base_config,
-                grid: dict = GRID) -> dict:
+                grid: dict = GRID, terms_grid: dict | None = None) -> dict:
     """Best cylinder parameters over `grid` (see the module docstring).
 
     Args:
         poses: [N, 4]; truth: [N] ground truth; fit: [N] bool, poses used for choosing.
         base_config: ReachabilityConfig giving the unsearched fields and the tie-break origin.
+        grid: thresholds (trunk_bottom, leg_bottom, leg_top) and radii (trunk_radius,
+            leg_radius) to search.
+        terms_grid: None (the optional terms keep base_config's values), or a dict like
+            TERMS_GRID whose radii replace grid's and whose leg_forward, foothold and
+            foothold_spread values are searched too.
 
     Returns:
         dict: config (the chosen ReachabilityConfig), met (targets met on the fitting
-        poses), candidates (number searched), fit_figures, table (best per radius pair).
+        poses), sensitive, candidates (number searched), fit_figures, table (the best
+        thresholds per setting of the radii and terms, in search order).
     """
     tb, lb, lt = np.meshgrid(grid["trunk_bottom"], grid["leg_bottom"], grid["leg_top"], indexing="ij")
     tb, lb, lt = tb.ravel(), lb.ravel(), lt.ravel()
     allowed = flat_ground_ok(tb, lb, lt)
     tb, lb, lt = tb[allowed], lb[allowed], lt[allowed]
+    if terms_grid is None:
+        radii = itertools.product(grid["trunk_radius"], grid["leg_radius"], (base_config.leg_forward,),
+                                  (None if base_config.foothold_spread is None else
+                                   (base_config.foothold_radius, base_config.foothold_search),))
+        spreads = (base_config.foothold_spread,)
+    else:
+        radii = itertools.product(terms_grid["trunk_radius"], terms_grid["leg_radius"], terms_grid["leg_forward"],
+                                  terms_grid["foothold"])
+        spreads = terms_grid["foothold_spread"]
     best, table = None, []
     base = np.array([base_config.trunk_radius, base_config.leg_radius, base_config.trunk_bottom,
                      base_config.leg_bottom, base_config.leg_top])
-    for trunk_radius, leg_radius in itertools.product(grid["trunk_radius"], grid["leg_radius"]):
-        samples = raster_samples(terrain, poses[fit], trunk_radius, leg_radius, base_config.leg_lateral_offset)
-        figures = confusion(thresholds(samples, tb, lb, lt), truth[fit])
-        sens, spec = figures["sensitivity"], figures["specificity"]
-        youden = sens + spec - 1
-        sensitive = sens >= TARGET_SENSITIVITY
-        met = sensitive & (spec >= TARGET_SPECIFICITY)
-        score = np.round(np.where(met, youden, np.where(sensitive, spec, youden)), 4)
-        params = np.column_stack([np.full(len(tb), trunk_radius), np.full(len(tb), leg_radius), tb, lb, lt])
-        distance = np.abs(params - base).sum(axis=1)
-        # Rank: both targets met (then the best Youden index); else the sensitivity
-        # target met (then the best specificity: a false negative ends episodes the
-        # generator could have walked, for good, while a false positive is caught by
-        # the generator in the planner-in-the-loop mode); else the best Youden index.
-        # Scores are rounded so that near-ties go to the parameters closest to the old defaults.
-        key = np.lexsort((distance, -score, ~sensitive, ~met))
-        k = int(key[0])
-        row = {"trunk_radius": trunk_radius, "leg_radius": leg_radius, "trunk_bottom": float(tb[k]),
-               "leg_bottom": float(lb[k]), "leg_top": float(lt[k]), "met": bool(met[k]),
-               "sensitive": bool(sensitive[k]), "score": float(score[k]),
-               "sensitivity": float(sens[k]), "specificity": float(spec[k]), "youden": float(youden[k]),
-               "distance": float(distance[k])}
-        table.append(row)
-        rank = (not row["met"], not row["sensitive"], -row["score"], row["distance"])
-        if best is None or rank < best[0]:
-            best = (rank, row)
+    for trunk_radius, leg_radius, leg_forward, foothold in radii:
+        samples = raster_samples(terrain, poses[fit], trunk_radius, leg_radius, base_config.leg_lateral_offset,
+                                 leg_forward, foothold)
+        for spread in ((None,) if foothold is None else spreads):
+            figures = confusion(thresholds(samples, tb, lb, lt, spread), truth[fit])
+            sens, spec = figures["sensitivity"], figures["specificity"]
+            youden = sens + spec - 1
+            sensitive = sens >= TARGET_SENSITIVITY
+            met = sensitive & (spec >= TARGET_SPECIFICITY)
+            score = np.round(np.where(met, youden, np.where(sensitive, spec, youden)), 4)
+            params = np.column_stack([np.full(len(tb), trunk_radius), np.full(len(tb), leg_radius), tb, lb, lt])
+            # tie-break: closest to the old defaults, and an optional term counts as 0.1 m away
+            distance = (np.abs(params - base).sum(axis=1) + abs(leg_forward - base_config.leg_forward)
+                        + 0.1 * (spread is not None))
+            # Rank: both targets met (then the best Youden index); else the sensitivity
+            # target met (then the best specificity: a false negative ends episodes the
+            # generator could have walked, for good, while a false positive is caught by
+            # the generator in the planner-in-the-loop mode); else the best Youden index.
+            # Scores are rounded so that near-ties go to the parameters closest to the old defaults.
+            key = np.lexsort((distance, -score, ~sensitive, ~met))
+            k = int(key[0])
+            row = {"trunk_radius": trunk_radius, "leg_radius": leg_radius, "trunk_bottom": float(tb[k]),
+                   "leg_bottom": float(lb[k]), "leg_top": float(lt[k]), "leg_forward": float(leg_forward),
+                   "foothold_radius": None if spread is None else float(foothold[0]),
+                   "foothold_search": None if spread is None else float(foothold[1]),
+                   "foothold_spread": None if spread is None else float(spread), "met": bool(met[k]),
+                   "sensitive": bool(sensitive[k]), "score": float(score[k]),
+                   "sensitivity": float(sens[k]), "specificity": float(spec[k]), "youden": float(youden[k]),
+                   "distance": float(distance[k])}
+            table.append(row)
+            rank = (not row["met"], not row["sensitive"], -row["score"], row["distance"])
+            if best is None or rank < best[0]:
+                best = (rank, row)
     row = best[1]
-    config = dataclasses.replace(base_config, **{k: row[k] for k in
-                                                 ("trunk_radius", "leg_radius", "trunk_bottom", "leg_bottom",
-                                                  "leg_top")})
+    fields = {k: row[k] for k in ("trunk_radius", "leg_radius", "trunk_bottom", "leg_bottom", "leg_top",
+                                  "leg_forward", "foothold_spread")}
+    if row["foothold_spread"] is not None:
+        fields.update(foothold_radius=row["foothold_radius"], foothold_search=row["foothold_search"])
+    config = dataclasses.replace(base_config, **fields)
     return {"config": config, "met": row["met"], "sensitive": row["sensitive"], "candidates": int(len(tb)) * len(table),
             "fit_figures": {"sensitivity": row["sensitivity"], "specificity": row["specificity"]},
             "table": table}
@@ -360,6 +461,18 @@ def breakdown(poses, truth, predicted, terrain, nominal: float = 1.0) -> list[di
         rows.append({"offset_from": round(float(lo), 2), "offset_to": round(float(lo + 0.1), 2),
                      "poses": int(band.sum()), "feasible": int(truth[band].sum()), **c})
     return rows
+
+
+def _describe(cfg) -> str:
+    """One line of a ReachabilityConfig: cylinders and the optional terms."""
+    text = (f"trunk r {cfg.trunk_radius:.2f} [{cfg.trunk_bottom:+.3f}, {cfg.trunk_top:+.2f}], "
+            f"legs r {cfg.leg_radius:.2f} [{cfg.leg_bottom:+.3f}, {cfg.leg_top:+.3f}]")
+    if cfg.leg_forward != 0.0:
+        text += f", lookahead legs {cfg.leg_forward:+.2f} m"
+    if cfg.foothold_spread is not None:
+        text += (f", foothold r {cfg.foothold_radius:.3f} within {cfg.foothold_search:.2f} m, "
+                 f"spread <= {cfg.foothold_spread:.3f} m")
+    return text
 
 
 def _fmt(c: dict) -> str:
@@ -396,19 +509,7 @@ def main(argv=None) -> None:
                                  leg_top=lt)
     poses = sample_poses(terrain, args.poses, args.seed)
     suffix = "" if args.truth == "static" else f"_{args.truth}"
-    cache = REPO / ".cache" / f"reachability_ground_truth{suffix}.npz"  # git-ignored
-    truth, gt_seconds = None, None
-    if args.reuse and cache.is_file():
-        with np.load(cache) as data:
-            if data["poses"].shape == poses.shape and np.array_equal(data["poses"], poses):
-                truth, gt_seconds = data["truth"], float(data["seconds"])
-                print(f"reused the ground truth of {cache}")
-    if truth is None:
-        start = time.perf_counter()
-        truth = ground_truth(terrain, poses, args.workers, truth=args.truth)
-        gt_seconds = time.perf_counter() - start
-        cache.parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(cache, poses=poses, truth=truth, seconds=gt_seconds)
+    truth, gt_seconds = cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse)
     print(f"ground truth: {len(poses)} poses, {int(truth.sum())} feasible, {gt_seconds:.0f} s "
           f"with {args.workers} workers ({1e3 * gt_seconds * max(args.workers, 1) / len(poses):.1f} ms per pose "
           f"per worker)")
@@ -418,13 +519,23 @@ def main(argv=None) -> None:
     search = grid_search(terrain, poses, truth, fit, old)
     search_seconds = time.perf_counter() - start
     new = search["config"]
+    start = time.perf_counter()
+    terms_search = grid_search(terrain, poses, truth, fit, old, terms_grid=TERMS_GRID)
+    terms_seconds = time.perf_counter() - start
+    with_terms = terms_search["config"]
     old_figures, old_pred = figures(terrain, poses, truth, old, fit)
     new_figures, new_pred = figures(terrain, poses, truth, new, fit)
+    terms_figures, terms_pred = figures(terrain, poses, truth, with_terms, fit)
     current = ReachabilityConfig()
     current_figures, current_pred = figures(terrain, poses, truth, current, fit)
-    # The NumPy thresholds of the search must agree with the jitted condition.
-    samples = raster_samples(terrain, poses, new.trunk_radius, new.leg_radius, new.leg_lateral_offset)
-    mismatch = int(np.sum(thresholds(samples, new.trunk_bottom, new.leg_bottom, new.leg_top) != new_pred))
+    # The NumPy thresholds of the searches must agree with the jitted condition.
+    mismatch = 0
+    for cfg, pred in ((new, new_pred), (with_terms, terms_pred)):
+        foothold = None if cfg.foothold_spread is None else (cfg.foothold_radius, cfg.foothold_search)
+        samples = raster_samples(terrain, poses, cfg.trunk_radius, cfg.leg_radius, cfg.leg_lateral_offset,
+                                 cfg.leg_forward, foothold)
+        mismatch += int(np.sum(thresholds(samples, cfg.trunk_bottom, cfg.leg_bottom, cfg.leg_top,
+                                          cfg.foothold_spread) != pred))
 
     print(f"\ngrid search: {search['candidates']} candidates in {search_seconds:.1f} s; best per radius pair "
           f"(fitting poses):")
@@ -434,35 +545,55 @@ def main(argv=None) -> None:
         print(f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
               f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {100 * row['sensitivity']:6.1f} "
               f"{100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
+    rank = lambda r: (not r["met"], not r["sensitive"], -r["score"], r["distance"])  # noqa: E731
+    print(f"\nsearch with the optional terms: {terms_search['candidates']} candidates in {terms_seconds:.1f} s; "
+          f"the 12 best settings (fitting poses):")
+    print(f"{'trunk r':>7s} {'leg r':>5s} {'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} {'fwd':>5s} "
+          f"{'foothold r/search/spread':>24s} {'sens %':>6s} {'spec %':>6s} {'met':>4s}")
+    for row in sorted(terms_search["table"], key=rank)[:12]:
+        foot = ("off" if row["foothold_spread"] is None else
+                f"{row['foothold_radius']:.3f}/{row['foothold_search']:.2f}/{row['foothold_spread']:.3f}")
+        print(f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
+              f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {row['leg_forward']:5.2f} {foot:>24s} "
+              f"{100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
     print()
-    for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new", new, new_figures),
+    for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new (cylinders only)", new, new_figures),
+                           ("new with the optional terms", with_terms, terms_figures),
                            ("current EnvConfig defaults", current, current_figures)):
-        print(f"{name}: trunk r {cfg.trunk_radius:.2f} [{cfg.trunk_bottom:+.3f}, {cfg.trunk_top:+.2f}], "
-              f"legs r {cfg.leg_radius:.2f} [{cfg.leg_bottom:+.3f}, {cfg.leg_top:+.3f}]")
+        print(f"{name}: {_describe(cfg)}")
         for part in ("all", "fit", "held_out"):
             print(f"  {part:9s} {_fmt(fig[part])}")
-    print(f"targets (sens >= {100 * TARGET_SENSITIVITY:.0f} %, spec >= {100 * TARGET_SPECIFICITY:.0f} %) "
-          f"{'met' if search['met'] else 'NOT met'} on the fitting poses (sensitivity target "
-          f"{'met' if search['sensitive'] else 'NOT met'}); jitted/NumPy mismatches: {mismatch}")
+    for name, result in (("cylinders only", search), ("with the optional terms", terms_search)):
+        print(f"{name}: targets (sens >= {100 * TARGET_SENSITIVITY:.0f} %, spec >= {100 * TARGET_SPECIFICITY:.0f} %) "
+              f"{'met' if result['met'] else 'NOT met'} on the fitting poses (sensitivity target "
+              f"{'met' if result['sensitive'] else 'NOT met'})")
+    print(f"jitted/NumPy mismatches: {mismatch}")
 
     as_dict = lambda c: dataclasses.asdict(c)  # noqa: E731
     save(f"reachability_calibration{suffix}", {"truth": args.truth,
         "terrain": str(Path(args.terrain).resolve().relative_to(REPO)) if Path(args.terrain).resolve().is_relative_to(REPO)
         else args.terrain,
         "poses": len(poses), "feasible": int(truth.sum()), "seed": args.seed, "workers": args.workers,
-        "ground_truth_seconds": gt_seconds, "search_seconds": search_seconds,
+        "ground_truth_seconds": gt_seconds, "search_seconds": search_seconds, "terms_search_seconds": terms_seconds,
         "sampling": {"z_offsets_m": Z_OFFSETS, "near_obstacle_fraction": NEAR_FRACTION,
                      "reference": f"highest terrain point within {REFERENCE_RADIUS} m", "nominal_m": 1.0},
         "targets": {"sensitivity": TARGET_SENSITIVITY, "specificity": TARGET_SPECIFICITY},
         "flat_ground_constraint": {"heights_m": FLAT_HEIGHTS, "margin_m": FLAT_MARGIN},
         "grid": {k: list(map(float, v)) for k, v in GRID.items()}, "candidates": search["candidates"],
+        "terms_grid": {k: list(v) for k, v in TERMS_GRID.items()}, "terms_candidates": terms_search["candidates"],
         "targets_met_on_fit": search["met"], "sensitivity_target_met_on_fit": search["sensitive"],
-        "chosen": as_dict(new), "old": as_dict(old), "current": as_dict(current),
-        "figures": {"old": old_figures, "new": new_figures, "current": current_figures},
+        "terms_targets_met_on_fit": terms_search["met"],
+        "terms_sensitivity_target_met_on_fit": terms_search["sensitive"],
+        "chosen": as_dict(new), "chosen_with_terms": as_dict(with_terms), "old": as_dict(old),
+        "current": as_dict(current),
+        "figures": {"old": old_figures, "new": new_figures, "new_with_terms": terms_figures,
+                    "current": current_figures},
         "by_height_offset": {"old": breakdown(poses, truth, old_pred, terrain),
                              "new": breakdown(poses, truth, new_pred, terrain),
+                             "new_with_terms": breakdown(poses, truth, terms_pred, terrain),
                              "current": breakdown(poses, truth, current_pred, terrain)},
-        "best_per_radius_pair": search["table"], "jit_numpy_mismatches": mismatch,
+        "best_per_radius_pair": search["table"], "best_per_terms_setting": terms_search["table"],
+        "jit_numpy_mismatches": mismatch,
     })
 
 

@@ -47,6 +47,20 @@ class ReachabilityConfig:
     # stands up to ~1.18 m above the soles (root lowered by at most 0.10 m)
     leg_bottom: float = -1.175
     leg_top: float = -0.55  # m below the root: highest reachable sole height, calibrated (DESIGN §5: -0.54)
+    # Optional terms (benchmarks/reachability_false_positives.py, issue 3 item 6); their
+    # defaults disable them, so the condition above is unchanged.
+    # m, lookahead: a second pair of leg cylinders at (leg_forward, ±leg_lateral_offset) in the
+    # root frame (same radius and band) must touch too: ground where the next steps land.
+    # 0 disables it.
+    leg_forward: float = 0.0
+    # m, foothold: radius of the sole disk whose height spread is measured (the 0.20 x 0.13 m
+    # sole has an inscribed radius of 0.065 m and a circumscribed one of 0.12 m)
+    foothold_radius: float = 0.08
+    # m, foothold: the flattest sole disk is searched within this radius of each leg centre
+    foothold_search: float = 0.10
+    # m, foothold: each leg needs, within foothold_search of its centre, a sole disk of radius
+    # foothold_radius over solid terrain (no void) whose heights span at most this. None disables it.
+    foothold_spread: float | None = None
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,9 @@ class Heightfield:
             (-inf where there is only void).
         leg_min: [nx, ny] lowest solid terrain point within `leg_radius` of the point
             (+inf where there is only void).
+        foothold: [nx, ny] smallest height spread of a sole disk of radius `foothold_radius`
+            centred within `foothold_search` of the point (+inf where every such disk touches
+            the void); [1, 1] zeros when the foothold term is disabled (`foothold_spread` None).
         origin: [2] world (x, y) of `heights[0, 0]`.
         resolution: [] cell size (m).
         void_height: [] height outside the grid.
@@ -43,6 +46,7 @@ class Heightfield:
     trunk_max: jax.Array
     leg_max: jax.Array
     leg_min: jax.Array
+    foothold: jax.Array
     origin: jax.Array
     resolution: jax.Array
     void_height: jax.Array
@@ -143,23 +147,55 @@ def _solid(heights: np.ndarray, void_height: float, fill: float) -> np.ndarray:
     return np.where(heights > void_height + 1e-6, heights, fill)
 
 
+def foothold_raster(heights: np.ndarray, void_height: float, resolution: float, foothold_radius: float,
+                    foothold_search: float) -> np.ndarray:
+    """Flatness of the best sole place near every grid point (host, NumPy).
+
+    spread[p] = max - min of the terrain heights over the disk of radius `foothold_radius`
+    around p, +inf when that disk touches the void (or leaves the grid): a sole cannot
+    stand over it. The raster is the min of spread over the disk of radius
+    `foothold_search` around each point (the foot may land anywhere near its centre).
+
+    Args:
+        heights: [nx, ny] terrain heights (m), world grid.
+        void_height: height of the void (m).
+        resolution: cell size (m).
+        foothold_radius: sole disk radius (m).
+        foothold_search: search radius (m); below one cell, the point itself only.
+
+    Returns:
+        [nx, ny] float32 spreads (m), +inf where no sole disk nearby is over solid terrain.
+    """
+    solid_or_inf = _solid(heights, void_height, np.inf)
+    highest = disk_filter(solid_or_inf, foothold_radius / resolution, "max", np.inf)
+    lowest = disk_filter(heights, foothold_radius / resolution, "min", void_height)
+    spread = highest - lowest  # inf - finite = inf
+    return disk_filter(spread, foothold_search / resolution, "min", np.inf).astype(np.float32)
+
+
 def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float, resolution: float,
-                  config: EnvConfig, spacing: float) -> np.ndarray:
+                  config: EnvConfig, spacing: float, foothold: np.ndarray | None = None) -> np.ndarray:
     """Grid indices [S, 2] where a root at nominal height is valid for every yaw.
 
     The leg cylinders turn with the yaw around the root; a point is kept when a
     cylinder of radius max(leg_radius - lateral offset, one cell) around it
     reaches solid ground within the leg band, which then holds for both legs
-    whatever the yaw, and when the point itself is solid ground. (Host, NumPy.)
+    whatever the yaw, and when the point itself is solid ground. With the lookahead legs
+    (`leg_forward`) the offset is that of the farthest leg centre; with the foothold term,
+    the foothold raster must pass within that distance of the point (every yaw).
+    (Host, NumPy.)
     """
     reach = config.reachability
     stride = max(int(round(spacing / resolution)), 1)
     z = heights + config.nominal_root_height
-    inner = max(reach.leg_radius - reach.leg_lateral_offset, resolution) / resolution
+    farthest = float(np.hypot(reach.leg_forward, reach.leg_lateral_offset))
+    inner = max(reach.leg_radius - farthest, resolution) / resolution
     inner_max = disk_filter(_solid(heights, void_height, -np.inf), inner, "max", -np.inf)
     inner_min = disk_filter(_solid(heights, void_height, np.inf), inner, "min", np.inf)
     ok = (trunk_max < z + reach.trunk_bottom) & (heights > void_height + 1e-6)
     ok &= (inner_max >= z + reach.leg_bottom) & (inner_min <= z + reach.leg_top)
+    if foothold is not None:
+        ok &= disk_filter(foothold, farthest / resolution, "max", np.inf) <= reach.foothold_spread
     # keep away from the grid border so that jittered resets stay inside
     ok[:stride, :] = ok[-stride:, :] = False
     ok[:, :stride] = ok[:, -stride:] = False
@@ -190,7 +226,11 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
     # so a disk over the void alone never touches, whatever the root height
     leg_max = disk_filter(_solid(heights, void_height, -np.inf), reach.leg_radius / resolution, "max", -np.inf)
     leg_min = disk_filter(_solid(heights, void_height, np.inf), reach.leg_radius / resolution, "min", np.inf)
-    spawn_ij = _spawn_points(heights, trunk_max, void_height, resolution, config, spawn_spacing)
+    if reach.foothold_spread is None:
+        foothold = None
+    else:
+        foothold = foothold_raster(heights, void_height, resolution, reach.foothold_radius, reach.foothold_search)
+    spawn_ij = _spawn_points(heights, trunk_max, void_height, resolution, config, spawn_spacing, foothold)
     if len(spawn_ij) == 0:
         if require_spawn:
             raise ValueError("the terrain has no valid spawn position for the root at nominal height")
@@ -199,6 +239,7 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
     f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
     return Heightfield(
         heights=f32(heights), trunk_max=f32(trunk_max), leg_max=f32(leg_max), leg_min=f32(leg_min),
+        foothold=f32(np.zeros((1, 1)) if foothold is None else foothold),
         origin=f32(origin), resolution=f32(resolution), void_height=f32(void_height),
         spawn_xy=f32(spawn_xy), spawn_spacing=f32(spawn_spacing),
     )

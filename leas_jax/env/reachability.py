@@ -14,8 +14,17 @@ A pose is valid when
     a vertical jump taller than the band (leg_top - leg_bottom) skips it
     entirely, e.g. a leg disk straddling a tall wall; the trunk test rejects
     most such poses.
+Two optional terms (disabled by the defaults of `ReachabilityConfig`; see
+benchmarks/reachability_false_positives.py for the false positives they target):
+  - lookahead (`leg_forward` != 0): a second pair of leg cylinders centred at
+    (leg_forward, ±leg_lateral_offset) in the root frame, same radius and band,
+    must touch as well: ground where the next steps land along the heading;
+  - foothold (`foothold_spread` not None): for each leg (and lookahead leg), within
+    `foothold_search` of its centre, a sole disk of radius `foothold_radius` over
+    solid terrain whose heights span at most `foothold_spread` (one raster,
+    `Heightfield.foothold`).
 Disk maxima and minima are precomputed rasters (`Heightfield`), so the test
-costs three gathers per leg pair.
+costs three gathers per leg pair (and one more per leg for the foothold).
 """
 
 import jax
@@ -32,26 +41,64 @@ def leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig
     return pose[:2] + rotate_z(offsets, pose[3])
 
 
+def ahead_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
+    """World (x, y) of the lookahead leg cylinders, at (leg_forward, ±leg_lateral_offset) in the
+    root frame. pose: [4] -> [2, 2] (left, right)."""
+    offsets = jnp.array([[config.leg_forward, config.leg_lateral_offset],
+                         [config.leg_forward, -config.leg_lateral_offset]])
+    return pose[:2] + rotate_z(offsets, pose[3])
+
+
+def all_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
+    """World (x, y) of every leg cylinder the condition tests: [2, 2] (left, right), or [4, 2]
+    (left, right, left ahead, right ahead) when the lookahead is enabled (`leg_forward` != 0).
+    pose: [4] (x, y, z, yaw), world."""
+    legs = leg_centers(pose, config)
+    if config.leg_forward != 0.0:
+        legs = jnp.concatenate([legs, ahead_leg_centers(pose, config)])
+    return legs
+
+
 def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> dict:
-    """The three parts of the condition.
+    """The parts of the condition.
 
     Args:
-        field: terrain with its reachability rasters (built with the same radii as `config`).
+        field: terrain with its reachability rasters (built with the same radii and the
+            same foothold settings as `config`).
         pose: [4] (x, y, z, yaw), world.
 
     Returns:
-        dict of bool[]: trunk_free, left_touch, right_touch.
+        dict of bool[]: trunk_free, left_touch, right_touch, left_ahead_touch,
+        right_ahead_touch (the lookahead legs; True when disabled), left_foothold,
+        right_foothold (over the legs and lookahead legs of each side; True when disabled).
     """
     z = pose[2]
     trunk_free = sample_nearest(field, field.trunk_max, pose[:2]) < z + config.trunk_bottom
-    legs = leg_centers(pose, config)
+    legs = all_leg_centers(pose, config)  # [L, 2], L = 2 or 4
     highest = sample_nearest(field, field.leg_max, legs, outside=-jnp.inf)
     lowest = sample_nearest(field, field.leg_min, legs, outside=jnp.inf)
-    touch = (highest >= z + config.leg_bottom) & (lowest <= z + config.leg_top)
-    return {"trunk_free": trunk_free, "left_touch": touch[0], "right_touch": touch[1]}
+    touch = (highest >= z + config.leg_bottom) & (lowest <= z + config.leg_top)  # [L]
+    yes = jnp.array(True)
+    ahead = (touch[2], touch[3]) if len(legs) == 4 else (yes, yes)
+    if config.foothold_spread is None:
+        foothold = (yes, yes)
+    else:
+        if field.foothold.shape != field.heights.shape:
+            raise ValueError("the foothold term is enabled but the heightfield has no foothold raster: "
+                             "build it with the same ReachabilityConfig")
+        flat = sample_nearest(field, field.foothold, legs, outside=jnp.inf) <= config.foothold_spread
+        flat = flat.reshape(-1, 2).all(axis=0)  # [2]: left, right (over the leg and its lookahead leg)
+        foothold = (flat[0], flat[1])
+    return {"trunk_free": trunk_free, "left_touch": touch[0], "right_touch": touch[1],
+            "left_ahead_touch": ahead[0], "right_ahead_touch": ahead[1],
+            "left_foothold": foothold[0], "right_foothold": foothold[1]}
 
 
 def valid(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
     """True when the root pose satisfies the reachability condition. pose: [4] -> bool[]."""
     t = terms(field, pose, config)
-    return t["trunk_free"] & t["left_touch"] & t["right_touch"]
+    out = t["trunk_free"]
+    for name in ("left_touch", "right_touch", "left_ahead_touch", "right_ahead_touch", "left_foothold",
+                 "right_foothold"):
+        out = out & t[name]
+    return out

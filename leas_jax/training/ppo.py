@@ -118,7 +118,13 @@ def init_state(config: TrainConfig, field: Heightfield) -> TrainState:
 
 
 def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield, key):
-    """Collect [B, T] transitions with the current stochastic policy; episode statistics."""
+    """Collect [B, T] transitions with the current stochastic policy; episode statistics.
+
+    Returns (state, data, stats). Every field of `data` is [B, T, ...] except
+    `next_observation`, [B, 1, 81]: the observation after the last step only,
+    which is all Brax's PPO loss reads of it (the value bootstrap), so the
+    other steps' next observations are neither stored nor shuffled.
+    """
     env = FreshResetVmap(LeasEnv(field, config.env))
     policy = ppo_networks.make_inference_fn(network)((state.normalizer, state.params.policy))
 
@@ -139,7 +145,7 @@ def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield,
         }
         transition = Transition(
             observation=env_state.obs, action=actions, reward=nstate.reward, discount=1 - done,
-            next_observation=nstate.obs,
+            next_observation=(),  # filled after the scan: the final observation only
             extras={"policy_extras": policy_extras, "state_extras": {"truncation": nstate.info["truncation"]}})
         carry = (nstate, ep_return * (1 - done), ep_length * (1 - done))
         return carry, (transition, stats)
@@ -148,6 +154,7 @@ def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield,
     (env_state, ep_return, ep_length), (data, stats) = jax.lax.scan(
         step, carry, jax.random.split(key, config.unroll_length))
     data = jax.tree.map(lambda x: jnp.swapaxes(x, 0, 1), data)  # [B, T, ...]
+    data = data._replace(next_observation=env_state.obs[:, None])  # [B, 1, 81]
     stats = {k: (v.sum() if k in ("episodes", "episode_return_sum", "episode_length_sum", "invalid_episodes")
                  else v.mean()) for k, v in stats.items()}
     return state.replace(env_state=env_state, episode_return=ep_return, episode_length=ep_length), data, stats

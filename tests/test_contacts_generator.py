@@ -207,3 +207,23 @@ def test_slow_leas_climb_of_eval_stairs_is_covered():
     plan = plan_contacts(load_terrain(scenario_file("stairs")), data["guide"], float(data["timestep"]))
     assert plan.coverage == 1.0
     assert verify(plan).ok
+
+
+def test_soles_turn_to_a_narrow_bridge_axis():
+    """Crossing the 0.30 m bridge with the root turned 0.2 rad off its axis: soles at the
+    guide's yaw do not fit side by side (2 x 0.152 m across), soles turned to the beam's
+    axis do; with the turning disabled the plan stops on the bridge."""
+    bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+                           + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    guide = straight(0.0, 5.0)
+    guide[:, 3] = 0.2
+    plan = plan_contacts(bridge, guide, DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    feet = plan.feet[np.isfinite(plan.feet[:, :, 0])]
+    on_bridge = feet[(feet[:, 0] > 2.1) & (feet[:, 0] < 3.9)]
+    yaws = np.arctan2(2 * (on_bridge[:, 6] * on_bridge[:, 5]), 1 - 2 * on_bridge[:, 5] ** 2)  # quaternion xyzw
+    assert len(on_bridge) >= 4 and np.abs(yaws).max() < 1e-6
+    stiff = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0))
+    assert stiff.coverage < 1.0
+    assert 2.0 < x_at(stiff, stiff.last_valid_index) < 4.0

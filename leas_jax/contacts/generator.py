@@ -18,7 +18,8 @@ Algorithm (DESIGN §6, after the RB-PRM contact generator of Tonneau et al., T-R
    lags more than the step trigger behind its nominal place, the foot that lags
    most steps: candidates are database samples (per-leg sole positions in the root
    frame) near where the foot should be `lookahead` s ahead on the guide, projected
-   on nearby support surfaces, kept when the sole rectangle lies inside the face
+   on nearby support surfaces (at the guide's yaw, and on narrow beams also turned to
+   the beam's axis), kept when the sole rectangle lies inside the face
    polygon and nothing covers it, then ranked by distance to that target. The step
    adds a single-support posture (foot in the air, NaN row; root shifted over the
    stance sole; balanced on the stance foot alone) and a double-support posture with
@@ -77,6 +78,14 @@ class GeneratorConfig:
     candidate_slab: float = 0.10  # m, samples this close (vertically) to a face are dropped on it
     candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
     max_candidates: int = 12  # candidates tried per step (in rank order)
+    # On a beam (a face narrower than `beam_width` across one of its edges), a sole turned
+    # by at most `beam_align_yaw` to the beam's axis is a candidate too, after the one at
+    # the guide's yaw at the same place. eval_bridge's 0.30 m beam leaves 2 cm beside two
+    # soles side by side; at 11 degrees off its axis they need 5 cm more, and LeaS guides
+    # wander that much (bridge success 8 -> 10 of 60 guides of the shipped policy). Beams
+    # only: aligning soles to every face's edges cost 5 of 60 eval_stairs guides.
+    beam_width: float = 0.5  # m; the arena's bridges are 0.30-0.45 m wide, its stair treads 0.30 m deep
+    beam_align_yaw: float = 0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables
     # m, sole rectangle kept this far inside the face polygon (DESIGN §6's 5 mm tolerance). Two
     # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin: with 1 cm and 2 cm that was
     # exactly the 0.30 m of eval_bridge, which no guide could cross: a centred straight guide at
@@ -144,6 +153,7 @@ class ContactGenerator:
         self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
         self._nominal_xy = [tuple(row[:2].tolist()) for row in self._nominal]
         self._faces = {}  # face index -> (inward edge normals [E, 3], offsets [E])
+        self._beam_axes = {}  # face index -> [A] yaws (rad) of the edges it is narrower than beam_width across
         # Diagnostics: postures built, candidates that passed the cover and reach tests
         # (those screened: `_step` screens its candidates lazily).
         self.stats = {"postures_tried": 0, "candidates": 0}
@@ -350,25 +360,27 @@ class ContactGenerator:
             # Database samples in a vertical column about the target, dropped vertically
             # on the face (reachability is re-checked exactly by IK below).
             world[:, 2] = (surfaces.offsets[s] - world[:, :2] @ normal[:2]) / normal[2]
-            rot = sole_rotation_single(normal, target_yaw)
-            inside = self._inside_face(s, world, rot)
-            points.append(world[inside])
-            owner.append(np.full(int(inside.sum()), s))
-            rotations.append(rot)
+            for yaw in self._sole_yaws(s, target_yaw):
+                rot = sole_rotation_single(normal, yaw)
+                inside = self._inside_face(s, world, rot)
+                points.append(world[inside])
+                owner.append(np.full(int(inside.sum()), len(rotations)))
+                rotations.append(rot)
         if not points:
             return empty
         pos = np.concatenate(points)
-        owner = np.concatenate(owner)
+        owner = np.concatenate(owner)  # index into `rotations`: one per (face, sole yaw)
+        # Stable: at equal distances the guide's yaw comes before the beam's (appended after it).
         order = np.argsort(np.hypot(pos[:, 0] - target_pos[0], pos[:, 1] - target_pos[1]), kind="stable")
         pos, owner = pos[order], owner[order]
-        # One candidate per grid cell and face (database samples cluster; coplanar
+        # One candidate per grid cell, face and sole yaw (database samples cluster; coplanar
         # neighbouring faces share dropped samples), the closest to the target.
         cells = np.round((pos[:, :2] - target_pos[:2]) / cfg.candidate_grid).astype(np.int64) + 1000
-        key = (cells[:, 0] * 2000 + cells[:, 1]) * (len(surfaces) + 1) + owner
+        key = (cells[:, 0] * 2000 + cells[:, 1]) * (len(rotations) + 1) + owner
         _, first = np.unique(key, return_index=True)
         keep = np.sort(first)
         pos, owner = pos[keep], owner[keep]
-        rot = np.stack(rotations)[np.searchsorted(near, owner)]
+        rot = np.stack(rotations)[owner]
         ok = np.ones(len(pos), dtype=bool)
         limit = 4 * cfg.max_candidates
         if avoid is not None and len(pos):
@@ -407,6 +419,28 @@ class ContactGenerator:
         keep = np.zeros(len(free), dtype=bool)
         keep[np.nonzero(free)[0][reachable]] = True
         return keep
+
+    def _sole_yaws(self, s: int, target_yaw: float) -> list[float]:
+        """Sole yaws (rad) tried on face s: the target's, then the axis of the beam the face
+        is (see `beam_width`) closest to it, when they differ by 1 mrad to `beam_align_yaw`."""
+        if s not in self._beam_axes:
+            verts = self.surfaces.surfaces[s].vertices
+            yaws = []
+            for edge in np.roll(verts, -1, axis=0) - verts:
+                axis = edge[:2] / max(math.hypot(edge[0], edge[1]), 1e-12)
+                across = np.ptp(verts[:, :2] @ np.array([-axis[1], axis[0]]))
+                if across < self.config.beam_width:
+                    yaws.append(math.atan2(axis[1], axis[0]))
+            self._beam_axes[s] = np.array(yaws)
+        axes = self._beam_axes[s]
+        if len(axes) == 0 or self.config.beam_align_yaw <= 0.0:
+            return [target_yaw]
+        # Differences wrapped to [-pi/2, pi/2): an axis has no sense.
+        diff = (axes - target_yaw + 0.5 * math.pi) % math.pi - 0.5 * math.pi
+        best = float(diff[np.argmin(np.abs(diff))])
+        if 1e-3 < abs(best) <= self.config.beam_align_yaw:
+            return [target_yaw, target_yaw + best]
+        return [target_yaw]
 
     def _inside_face(self, s: int, centres: np.ndarray, rot: np.ndarray) -> np.ndarray:
         """[N] whether soles with centres [N, 3] on face s and orientation rot [3, 3] lie

@@ -32,7 +32,7 @@ class ReachabilityConfig:
     DESIGN §5's 0.30 m radius. Against the static truth these defaults give
     sensitivity 56.0 %, specificity 89.6 % (the crouched postures count as feasible there).
     The walking truth above predates the generator's 5 mm sole-edge margin (commit 157e3f5);
-    recomputed with it, these defaults give 95.8 % / 82.2 % (all poses). The optional
+    recomputed with it (generator sources of e5771a8), these defaults give 95.8 % / 82.2 % (all poses). The optional
     lookahead and foothold terms below (off by default) reach 95.6 % / 86.6 % at best
     (benchmarks/reachability_calibration.py's second search): still short of 90 %.
     """

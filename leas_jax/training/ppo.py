@@ -18,6 +18,7 @@ import jax
 import jax.numpy as jnp
 import optax
 from brax.training import gradients
+from brax.training import networks as brax_networks
 from brax.training.acme import running_statistics, specs
 from brax.training.agents.ppo import losses as ppo_losses
 from brax.training.agents.ppo import networks as ppo_networks
@@ -188,13 +189,31 @@ def _sgd(config: TrainConfig, network, optimizer, state: TrainState, data: Trans
     return state.replace(params=params, optimizer_state=opt_state), metrics
 
 
+def flat_batch_networks(network: ppo_networks.PPONetworks) -> ppo_networks.PPONetworks:
+    """`network` with its policy and value applied to a 2-D batch.
+
+    Brax's PPO loss applies the networks to [T, B, 81] observations. The
+    weight gradients of a 3-D input reach XLA:CPU as products with a
+    transposed [64, T*B] copy, about three times slower than the [T*B, 64]
+    products of a 2-D input; the loss's gradient took 40 % less time with the
+    batch flattened. Same parameters and results (up to float rounding).
+    """
+    def flat(ffn: brax_networks.FeedForwardNetwork) -> brax_networks.FeedForwardNetwork:
+        def apply(normalizer, params, obs):
+            """obs: [..., 81] -> [..., outputs], through a [prod(...), 81] batch."""
+            out = ffn.apply(normalizer, params, obs.reshape((-1, obs.shape[-1])))
+            return out.reshape(obs.shape[:-1] + out.shape[1:])
+        return brax_networks.FeedForwardNetwork(init=ffn.init, apply=apply)
+    return network.replace(policy_network=flat(network.policy_network), value_network=flat(network.value_network))
+
+
 def make_train_call(config: TrainConfig):
     """Jitted `(state, field) -> (state, metrics)` running `iterations_per_call` PPO iterations.
 
     Metrics: per-call means of the per-iteration statistics, plus sums of the
     episode counters (episodes, episode_return_sum, ...).
     """
-    network = make_networks(config)
+    network = flat_batch_networks(make_networks(config))
     optimizer = make_optimizer(config)
 
     def iteration(state: TrainState, field: Heightfield):

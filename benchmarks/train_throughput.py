@@ -9,6 +9,7 @@ times `--calls` calls. Writes results/train_throughput.json.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -29,17 +30,21 @@ def measure(config, field, calls: int) -> dict:
     state, metrics = call(state, field)
     jax.block_until_ready(metrics)
     compile_s = time.perf_counter() - t0
+    load_before = os.getloadavg()[0]
     t0 = time.perf_counter()
     for _ in range(calls):
         state, metrics = call(state, field)
     jax.block_until_ready(metrics)
     run_s = time.perf_counter() - t0
+    load_after = os.getloadavg()[0]
     steps = calls * config.iterations_per_call * config.batch_size
     return {"preset": config.preset, "num_envs": config.num_envs, "unroll_length": config.unroll_length,
             "num_minibatches": config.num_minibatches, "num_epochs": config.num_epochs,
             "compile_s": round(compile_s, 2), "run_s": round(run_s, 3), "env_steps": steps,
             "env_steps_per_s": round(steps / run_s),
-            "minutes_for_80M_steps": round(80e6 / (steps / run_s) / 60, 1)}
+            "minutes_for_80M_steps": round(80e6 / (steps / run_s) / 60, 1),
+            # 1-minute load average before and after the timed calls: other jobs on the machine slow it down
+            "load_average_1min": [round(load_before, 2), round(load_after, 2)], "cpus": os.cpu_count()}
 
 
 def main() -> None:
@@ -62,7 +67,8 @@ def main() -> None:
             rows.append(row)
             print(f"{name:6s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
                   f"{row['env_steps_per_s']:>10,} env steps/s, 80 M steps in {row['minutes_for_80M_steps']} min "
-                  f"(compile {row['compile_s']} s)", flush=True)
+                  f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
+                  f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)", flush=True)
     save("train_throughput", {"rows": rows})
 
 

@@ -14,7 +14,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from leas_jax.env import EnvConfig, FreshResetVmap, LeasEnv, heightfield_from_terrain
+from leas_jax.env import FreshResetVmap, LeasEnv, heightfield_from_terrain
 from leas_jax.env.wrappers import reset_capacities
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import preset

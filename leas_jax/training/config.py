@@ -146,7 +146,7 @@ PRESETS = {
     "smoke": dict(num_timesteps=400_000, num_envs=512, unroll_length=16, num_minibatches=4,
                   num_epochs=4, iterations_per_call=4),
     # the paper's 80 M-step budget in about 7 minutes on 2 cores: 3 epochs of 8
-    # mini-batches (benchmarks/train_throughput.py: ~200 k env steps/s here)
+    # mini-batches (benchmarks/train_throughput.py: 176-185 k env steps/s here at load 1.5)
     "quick": dict(num_timesteps=80_000_000, num_epochs=3, num_minibatches=8),
     # the paper's budget and sample reuse: 80 M steps, 10 epochs (Table I), ~25 minutes here
     "paper": dict(num_timesteps=80_000_000, num_epochs=10, num_minibatches=8),

@@ -31,10 +31,14 @@ class ReachabilityConfig:
     0.3 points of specificity ahead on the fitting poses, a tie: the trunk keeps
     DESIGN §5's 0.30 m radius. Against the static truth these defaults give
     sensitivity 56.0 %, specificity 89.6 % (the crouched postures count as feasible there).
-    The walking truth above predates the generator's 5 mm sole-edge margin (commit 157e3f5);
-    recomputed with it (generator sources of e5771a8), these defaults give 95.8 % / 82.2 % (all poses). The optional
-    lookahead and foothold terms below (off by default) reach 95.6 % / 86.6 % at best
-    (benchmarks/reachability_calibration.py's second search): still short of 90 %.
+    The walking truth above predates the generator's 5 mm sole-edge margin (commit 157e3f5),
+    7 cm step trigger and beam-aligned soles (fb311e9). Recomputed with the generator of
+    fb311e9 (`python benchmarks/reachability_calibration.py --truth walking`, 2026-11-22),
+    these defaults give sensitivity 95.0 %, specificity 83.7 % (all poses; held-out
+    94.0 / 84.6 %). The best cylinders alone reach 94.7 / 85.1 %; with the optional
+    lookahead and foothold terms below (off by default) 94.4 / 88.1 % (fitting poses
+    95.1 / 87.8 %): still short of 90 %, so the defaults stay (changing them retrains
+    the shipped policy).
     """
 
     # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)

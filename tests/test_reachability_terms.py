@@ -204,3 +204,20 @@ size = [2.0, 1.0, 0.2]
         np.testing.assert_array_equal(numpy, jitted)
         # the term matters on these poses: it rejects some that the plain condition accepts
         assert np.sum(rc.condition(terrain, poses, ReachabilityConfig()) & ~jitted) > 0
+
+
+def test_default_spawn_points_are_valid_for_every_yaw():
+    """A 0.20 m wide trench in flat ground: with the calibrated narrow legs (r 0.05 m at
+    0.085 m) a leg disk fits inside it, so a root beside the trench is valid only for
+    some yaws; no spawn point may be such a root."""
+    heights = np.zeros((SIZE, SIZE), np.float32)
+    heights[cell(2.0):cell(2.2), :] = VOID
+    reach = ReachabilityConfig()
+    field = field_of(heights, reach, require_spawn=True)
+    spawn = np.asarray(field.spawn_xy)
+    assert len(spawn) > 100
+    yaws = np.linspace(-math.pi, math.pi, 16, endpoint=False)
+    xy = np.repeat(spawn, len(yaws), axis=0)
+    poses = np.column_stack([xy, np.ones(len(xy)), np.tile(yaws, len(spawn))]).astype(np.float32)
+    ok = np.asarray(jax.jit(jax.vmap(lambda p: reachability.valid(field, p, reach)))(poses))
+    assert ok.all(), poses[~ok][:5]

@@ -177,23 +177,34 @@ def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float
                   config: EnvConfig, spacing: float, foothold: np.ndarray | None = None) -> np.ndarray:
     """Grid indices [S, 2] where a root at nominal height is valid for every yaw.
 
-    The leg cylinders turn with the yaw around the root; a point is kept when a
-    cylinder of radius max(leg_radius - lateral offset, one cell) around it
-    reaches solid ground within the leg band, which then holds for both legs
-    whatever the yaw, and when the point itself is solid ground. With the lookahead legs
-    (`leg_forward`) the offset is that of the farthest leg centre; with the foothold term,
-    the foothold raster must pass within that distance of the point (every yaw).
-    (Host, NumPy.)
+    The leg cylinders turn with the yaw around the root, their centres `farthest` m
+    from it (the lateral offset; with the lookahead legs, `leg_forward`, the farthest
+    leg centre). A point is kept when it is solid ground, the trunk is free, and
+      - legs wider than that distance (leg_radius > farthest + one cell): the small
+        disk of radius leg_radius - farthest around the point, which lies inside
+        every leg disk whatever the yaw, reaches solid ground within the leg band;
+      - narrower legs (the calibrated 0.05 m at 0.085 m): every point within
+        farthest + leg_radius + one cell, a disk that holds every leg disk whatever
+        the yaw, is solid ground within the band.
+    With the foothold term, the foothold raster must pass within `farthest` of the
+    point (every yaw). (Host, NumPy.)
     """
     reach = config.reachability
     stride = max(int(round(spacing / resolution)), 1)
     z = heights + config.nominal_root_height
     farthest = float(np.hypot(reach.leg_forward, reach.leg_lateral_offset))
-    inner = max(reach.leg_radius - farthest, resolution) / resolution
-    inner_max = disk_filter(_solid(heights, void_height, -np.inf), inner, "max", -np.inf)
-    inner_min = disk_filter(_solid(heights, void_height, np.inf), inner, "min", np.inf)
     ok = (trunk_max < z + reach.trunk_bottom) & (heights > void_height + 1e-6)
-    ok &= (inner_max >= z + reach.leg_bottom) & (inner_min <= z + reach.leg_top)
+    if reach.leg_radius > farthest + resolution:
+        inner = (reach.leg_radius - farthest) / resolution
+        highest = disk_filter(_solid(heights, void_height, -np.inf), inner, "max", -np.inf)
+        lowest = disk_filter(_solid(heights, void_height, np.inf), inner, "min", np.inf)
+        ok &= (highest >= z + reach.leg_bottom) & (lowest <= z + reach.leg_top)
+    else:
+        # + one cell: the condition reads each leg at the grid point nearest to its centre
+        outer = (farthest + reach.leg_radius + resolution) / resolution
+        lowest = disk_filter(_solid(heights, void_height, -np.inf), outer, "min", -np.inf)
+        highest = disk_filter(heights, outer, "max", np.inf)
+        ok &= (lowest >= z + reach.leg_bottom) & (highest <= z + reach.leg_top)
     if foothold is not None:
         ok &= disk_filter(foothold, farthest / resolution, "max", np.inf) <= reach.foothold_spread
     # keep away from the grid border so that jittered resets stay inside

@@ -27,6 +27,8 @@ Disk maxima and minima are precomputed rasters (`Heightfield`), so the test
 costs three gathers per leg pair (and one more per leg for the foothold).
 """
 
+import dataclasses
+
 import jax
 import jax.numpy as jnp
 
@@ -37,26 +39,17 @@ from leas_jax.env.kinematics import rotate_z
 
 def leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
     """World (x, y) of the left and right leg cylinders. pose: [4] -> [2, 2] (left, right)."""
-    offsets = jnp.array([[0.0, config.leg_lateral_offset], [0.0, -config.leg_lateral_offset]])
-    return pose[:2] + rotate_z(offsets, pose[3])
-
-
-def ahead_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
-    """World (x, y) of the lookahead leg cylinders, at (leg_forward, ±leg_lateral_offset) in the
-    root frame. pose: [4] -> [2, 2] (left, right)."""
-    offsets = jnp.array([[config.leg_forward, config.leg_lateral_offset],
-                         [config.leg_forward, -config.leg_lateral_offset]])
-    return pose[:2] + rotate_z(offsets, pose[3])
+    return all_leg_centers(pose, dataclasses.replace(config, leg_forward=0.0))
 
 
 def all_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
-    """World (x, y) of every leg cylinder the condition tests: [2, 2] (left, right), or [4, 2]
-    (left, right, left ahead, right ahead) when the lookahead is enabled (`leg_forward` != 0).
+    """World (x, y) of every leg cylinder the condition tests: at (0, ±leg_lateral_offset) in
+    the root frame, [2, 2] (left, right), then at (leg_forward, ±leg_lateral_offset) when the
+    lookahead is enabled (`leg_forward` != 0): [4, 2] (left, right, left ahead, right ahead).
     pose: [4] (x, y, z, yaw), world."""
-    legs = leg_centers(pose, config)
-    if config.leg_forward != 0.0:
-        legs = jnp.concatenate([legs, ahead_leg_centers(pose, config)])
-    return legs
+    forwards = (0.0,) if config.leg_forward == 0.0 else (0.0, config.leg_forward)
+    offsets = jnp.array([[x, side * config.leg_lateral_offset] for x in forwards for side in (1.0, -1.0)])
+    return pose[:2] + rotate_z(offsets, pose[3])
 
 
 def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> dict:
@@ -96,9 +89,4 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
 
 def valid(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
     """True when the root pose satisfies the reachability condition. pose: [4] -> bool[]."""
-    t = terms(field, pose, config)
-    out = t["trunk_free"]
-    for name in ("left_touch", "right_touch", "left_ahead_touch", "right_ahead_touch", "left_foothold",
-                 "right_foothold"):
-        out = out & t[name]
-    return out
+    return jnp.all(jnp.stack(list(terms(field, pose, config).values())))

@@ -138,6 +138,20 @@ def test_hole_stops_before_it():
     assert verify(plan).ok
 
 
+def test_crouched_walk_is_covered_and_too_low_stops():
+    """Talos walks with its root 0.85 m above flat ground (the swing foot lifted under its hip
+    used to be placed at the half-sitting sole height, 12 cm underground there: coverage
+    0.17); at 0.70 m no step is possible."""
+    crouched = straight(0.0, 2.0)
+    crouched[:, 2] = 0.85
+    plan = plan_contacts(FLAT, crouched, DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    too_low = crouched.copy()
+    too_low[:, 2] = 0.70
+    assert plan_contacts(FLAT, too_low, DT).coverage < 0.2
+
+
 def test_guide_too_high_stops():
     guide = straight(0.0, 4.0)
     guide[:, 2] = H + np.clip((guide[:, 0] - 2.0) * 0.5, 0.0, 0.4)  # rises from x = 2

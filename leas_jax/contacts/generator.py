@@ -515,8 +515,13 @@ class ContactGenerator:
         stance = (other, feet[other][0], feet[other][1])
         old_pos, old_rot = feet[side]
         lifted = [(old_pos + np.array([0.0, 0.0, cfg.swing_lift]), old_rot)]
+        # Or under its hip, swing_lift above its last contact (or above the half-sitting sole
+        # height where that is higher, as on a step up). The half-sitting height alone put the
+        # foot 12 cm underground under a root 0.85 m above the ground, where crouched walking
+        # fails otherwise (the trailing foot cannot stay flat: ankle pitch < -1.31 rad).
         nominal_pos, _ = self._nominal_placement(pose, side)
-        lifted.append((nominal_pos + np.array([0.0, 0.0, cfg.swing_lift]), _rotz(pose[3])))
+        nominal_pos[2] = max(nominal_pos[2], old_pos[2]) + cfg.swing_lift
+        lifted.append((nominal_pos, _rotz(pose[3])))
         single = self._posture(pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2])
         if single is None:
             return None

@@ -42,7 +42,8 @@ def cmd_evaluate(args) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} exists and is not a directory")
     report = evaluate(scenarios, parse_methods(args.methods), args.checkpoint, out, args.n_starts, args.workers,
-                      terrain_file=args.terrain, progress=not args.no_progress, address=args.ray_address)
+                      terrain_file=args.terrain, progress=not args.no_progress, address=args.ray_address,
+                      leas_stop_at_invalid=args.leas_stop_at_invalid)
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))
     for row in report["rows"]:
@@ -75,6 +76,10 @@ def register(subparsers) -> None:
                         help="contact-generator and RRT processes (default one per CPU; 0: in-process), or Ray actors "
                              "with --ray-address (default: the cluster's CPUs)")
     add_ray_address_argument(parser, "run the contact generator")
+    parser.add_argument("--leas-stop-at-invalid", action="store_true",
+                        help="end LeaS paths before the first pose the reachability condition rejects, as training "
+                             "episodes end (default: the policy rolls on and the contact generator alone judges its "
+                             "paths, as it judges the baselines' paths)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.set_defaults(func=cmd_evaluate)

@@ -151,23 +151,27 @@ def _rrt_plans(field, terrain, env, starts: Starts, target, config, rrt_config, 
         return list(tqdm(pool.map(_rrt_worker_plan, jobs), **bar))
 
 
-def _leas_guides(policy, field, starts: Starts, routes: list[np.ndarray], max_steps: int) -> list:
+def _leas_guides(policy, field, starts: Starts, routes: list[np.ndarray], max_steps: int,
+                 stop_at_invalid: bool) -> list:
     from leas_jax.steering.leas import rollout_batch
 
     width = max(len(r) for r in routes)
     # Pad every route to the same length by repeating its last point (rollout_batch's convention).
     padded = np.stack([np.concatenate([r, np.repeat(r[-1:], width - len(r), axis=0)]) for r in routes])
-    result = rollout_batch(policy, field, starts.poses, padded, starts.speeds, max_steps=max_steps)
+    result = rollout_batch(policy, field, starts.poses, padded, starts.speeds, max_steps=max_steps,
+                           stop_at_invalid=stop_at_invalid)
     return [result.guide(n).astype(np.float64) for n in range(len(starts.poses))]
 
 
 def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, policy, n_starts: int,
                        config, rrt_config, progress: bool = True, env=None,
-                       rrt_workers: int = 0) -> tuple[list[Trajectory], dict]:
+                       rrt_workers: int = 0, leas_stop_at_invalid: bool = False) -> tuple[list[Trajectory], dict]:
     """Starts and guides of every cell and method of one scenario (no validation yet).
 
     `env` (default: the policy's, else EnvConfig()) is what `field` was built with;
-    `rrt_workers` processes run the RRT searches (0: in this process).
+    `rrt_workers` processes run the RRT searches (0: in this process);
+    `leas_stop_at_invalid`: LeaS paths end before the first pose the reachability
+    condition rejects (see `rollout_batch`; default: they roll on, see `evaluate`).
 
     Returns:
         (trajectories, seconds spent per method building guides).
@@ -210,7 +214,7 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
             began = time.perf_counter()
             steps = max(leas_horizon(p[:2], points, config.target_speed, config.timestep, horizon)
                         for p in starts.poses)
-            add("leas", _leas_guides(policy, field, starts, [points] * n_starts, steps),
+            add("leas", _leas_guides(policy, field, starts, [points] * n_starts, steps, leas_stop_at_invalid),
                 [points] * n_starts if len(points) > 1 else None)
             seconds["leas"] += time.perf_counter() - began
         if "leas_rrt" in methods:
@@ -222,7 +226,7 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
                 routes = [plans[n].waypoints for n in ok]
                 steps = max(leas_horizon(starts.poses[n, :2], plans[n].waypoints, config.target_speed,
                                          config.timestep, horizon) for n in ok)
-                for n, guide in zip(ok, _leas_guides(policy, field, sub, routes, steps)):
+                for n, guide in zip(ok, _leas_guides(policy, field, sub, routes, steps, leas_stop_at_invalid)):
                     guides[n] = guide
             add("leas_rrt", guides, [p.waypoints if p.success else None for p in plans],
                 [None if p.success else "rrt: no path" for p in plans])
@@ -269,7 +273,8 @@ def default_workers() -> int:
 
 
 def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, workers: int, config=None,
-                 rrt_config=None, progress: bool = True, address: str | None = None) -> ScenarioResult:
+                 rrt_config=None, progress: bool = True, address: str | None = None,
+                 leas_stop_at_invalid: bool = False) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
     Args:
@@ -283,6 +288,8 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
         rrt_config: `RRTConfig` (the seed of start k is its seed + k).
         progress: show progress bars.
         address: a Ray cluster address for the contact generator (None: local processes).
+        leas_stop_at_invalid: LeaS paths end before the first pose the reachability
+            condition rejects (False: the contact generator alone judges them).
     """
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
@@ -298,7 +305,7 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
     result = ScenarioResult(name, terrain, cells, tuple(methods))
     result.trajectories, result.seconds = build_trajectories(
         name, terrain, field, cells, methods, policy, n, config, rrt_config or RRTConfig(), progress, env,
-        rrt_workers=workers or 0)
+        rrt_workers=workers or 0, leas_stop_at_invalid=leas_stop_at_invalid)
     began = time.perf_counter()
     validate(terrain, result.trajectories, config.timestep, workers, progress, desc=f"{name}: contact planning",
              address=address)
@@ -308,7 +315,7 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
 
 def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int | None = None,
              workers: int | None = None, terrain_file=None, progress: bool = True, rrt_config=None,
-             figures: bool = True, address: str | None = None) -> dict:
+             figures: bool = True, address: str | None = None, leas_stop_at_invalid: bool = False) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
     Args:
@@ -325,6 +332,15 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
         figures: write PNG figures.
         address: contact generator on a Ray cluster ("ray://HOST:PORT", "auto",
             "local"; see `leas_jax.contacts.ray_backend`); None: local processes.
+        leas_stop_at_invalid: end LeaS paths before the first pose the reachability
+            condition rejects, as training episodes end. By default (False) the policy
+            rolls on through such poses and the contact generator alone judges its
+            path, as it judges the baselines' paths, which nothing cuts either (the
+            paper's RBLin paths "lead inside the hole", §IV-B.2). The condition is a
+            training proxy of the generator (benchmarks/reachability_calibration.py:
+            ~84 % specificity, and it rejects poses the generator walks through: 5 of
+            the shipped policy's 10 circuit paths end at a rejected pose on a step
+            down that the generator then walks).
 
     Returns:
         the results dictionary written to results.json.
@@ -359,8 +375,10 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
     results = []
     for name, terrain in jobs:
         results.append(run_scenario(name, terrain, wanted[name], policy, n_starts, workers,
-                                    rrt_config=rrt_config, progress=progress, address=address))
-    report = tables.results_dict(results, policy=policy, seconds=time.perf_counter() - began)
+                                    rrt_config=rrt_config, progress=progress, address=address,
+                                    leas_stop_at_invalid=leas_stop_at_invalid))
+    report = tables.results_dict(results, policy=policy, seconds=time.perf_counter() - began,
+                                 leas_stop_at_invalid=leas_stop_at_invalid)
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)

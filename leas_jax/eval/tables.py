@@ -46,10 +46,11 @@ def rows(results) -> list[dict]:
     return out
 
 
-def results_dict(results, policy=None, seconds: float = 0.0) -> dict:
+def results_dict(results, policy=None, seconds: float = 0.0, leas_stop_at_invalid: bool = False) -> dict:
     """Everything results.json holds: config, per-trajectory metrics, summaries, Table II."""
     report = {"format": "leas-evaluation-v1",
-              "policy": None if policy is None else {"source": policy.source, "env_steps": int(policy.env_steps)},
+              "policy": None if policy is None else {"source": policy.source, "env_steps": int(policy.env_steps),
+                                                     "stop_at_invalid": bool(leas_stop_at_invalid)},
               "seconds": round(float(seconds), 3), "scenarios": {}, "rows": [], "table_ii": None}
     for result in results:
         scenario = result.terrain.scenario
@@ -122,7 +123,12 @@ def markdown(report: dict) -> str:
     """table.md: Table II (when ground ran), then every scenario's coverage and success per cell and method."""
     parts = ["# LeaS evaluation", ""]
     if report.get("policy"):
-        parts += [f"Policy: `{report['policy']['source']}` ({report['policy']['env_steps']:,} training steps).", ""]
+        policy = report["policy"]
+        ends = ("its paths end before the first pose the reachability condition rejects"
+                if policy.get("stop_at_invalid", False) else
+                "its paths roll on through poses the reachability condition rejects (the contact generator alone "
+                "judges them, as it judges the baselines' paths)")
+        parts += [f"Policy: `{policy['source']}` ({policy['env_steps']:,} training steps); {ends}.", ""]
     parts += ["coverage: mean arc-length fraction of the guide covered by the contact plan; success: the plan covers "
               "the whole guide and a posture's root is within 0.30 m of the target (DESIGN §8).", ""]
     if report.get("table_ii"):

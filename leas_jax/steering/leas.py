@@ -29,7 +29,8 @@ class RolloutResult:
     Attributes:
         poses: [N, T + 1, 4] (x, y, z, yaw) world; entries after `lengths[n]` repeat the last pose.
         lengths: [N] number of valid poses of each path (start included).
-        invalid: [N] the episode ended on an invalid configuration (the invalid pose is excluded).
+        invalid: [N] the path met a pose the reachability condition rejects: with
+            `stop_at_invalid` it ends before that pose, without it the pose is kept.
         reached: [N] the root came within the threshold of the last target.
         timestep: s between poses.
     """
@@ -47,7 +48,7 @@ class RolloutResult:
 
 @functools.lru_cache(maxsize=16)
 def _compiled_rollout(env_config: EnvConfig, policy_key, max_steps: int, switch_distance: float,
-                      stop_at_target: bool):
+                      stop_at_target: bool, stop_at_invalid: bool):
     """Jitted batch rollout for one env config and horizon (cached)."""
     policy = policy_key.policy
     env_config = dataclasses.replace(env_config, stop_at_target=False, episode_length=max_steps + 1)
@@ -72,7 +73,7 @@ def _compiled_rollout(env_config: EnvConfig, policy_key, max_steps: int, switch_
                 new_root = new_root.replace(target_point=wps[wp_index])
                 new = new.replace(pipeline_state=new_root)
                 now_invalid = alive & (new.metrics["invalid"] > 0)
-                keep = alive & ~now_invalid
+                keep = alive & ~(now_invalid & stop_at_invalid)
                 state = jax.tree.map(lambda a, b: jnp.where(keep, a, b), new, state)
                 pose = jnp.where(keep, new_root.pose, root.pose)
                 reached = reached | (keep & hit_last)
@@ -112,7 +113,7 @@ def start_poses(field: Heightfield, starts_xy_yaw: np.ndarray, nominal_root_heig
 
 def rollout_batch(policy, field: Heightfield, starts: np.ndarray, targets, speeds=None,
                   max_steps: int | None = None, switch_distance: float | None = None,
-                  stop_at_target: bool = True) -> RolloutResult:
+                  stop_at_target: bool = True, stop_at_invalid: bool = True) -> RolloutResult:
     """Roll the deterministic policy from N starts.
 
     Args:
@@ -126,6 +127,10 @@ def rollout_batch(policy, field: Heightfield, starts: np.ndarray, targets, speed
         switch_distance: switch waypoints / count the target reached within this
             distance (m); default the env's target_reached_distance (0.20 m).
         stop_at_target: end a path when its last target is reached.
+        stop_at_invalid: end a path before the first pose the reachability condition
+            rejects (the training episode's termination); False rolls on through it,
+            leaving the contact generator alone to judge the path, as it judges the
+            baselines' paths.
     """
     env_config = policy.config.env
     starts = np.asarray(starts, np.float32).reshape(-1, 4)
@@ -138,7 +143,8 @@ def rollout_batch(policy, field: Heightfield, starts: np.ndarray, targets, speed
     speeds = np.zeros(n, np.float32) if speeds is None else np.broadcast_to(np.asarray(speeds, np.float32), (n,))
     max_steps = int(max_steps or env_config.episode_length)
     switch = float(switch_distance or env_config.target_reached_distance)
-    run = _compiled_rollout(env_config, _PolicyKey(policy), max_steps, switch, bool(stop_at_target))
+    run = _compiled_rollout(env_config, _PolicyKey(policy), max_steps, switch, bool(stop_at_target),
+                            bool(stop_at_invalid))
     n_wp = np.full(n, waypoints.shape[1], np.int32)
     poses, lengths, invalid, reached = jax.device_get(run(field, starts, speeds, waypoints, n_wp))
     return RolloutResult(poses=np.asarray(poses), lengths=np.asarray(lengths), invalid=np.asarray(invalid),

@@ -44,9 +44,9 @@ class ReachabilityConfig:
     0.80-1.15 m up (benchmarks/walking_height.py), and 2537 of the 12 000 poses are
     feasible instead of 2027. Against it these defaults give sensitivity 82.3 %,
     specificity 84.5 % (447 of the 450 rejected feasible poses are crouched ones that
-    fail the trunk term: median 0.785 m above the ground under the trunk); the search's best at >= 95 % sensitivity
-    on the fitting poses (trunk bottom -0.75, leg top -0.775) gives 94.3 / 80.9 % on all
-    poses. The defaults are kept: a false positive is a guide the generator cannot
+    fail the trunk term: median 0.785 m above the ground under the trunk); the search's
+    best at >= 95 % sensitivity on the fitting poses (trunk bottom -0.75, leg top -0.775)
+    gives 94.3 / 80.9 % on all poses. The defaults are kept: a false positive is a guide the generator cannot
     follow, a false negative only keeps the policy higher than it needs to be (the
     generator walks there too), and the shipped policy was trained with them.
     """

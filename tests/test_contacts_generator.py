@@ -163,6 +163,19 @@ def test_guide_too_high_stops():
     assert verify(plan).ok
 
 
+def test_single_support_with_a_shorter_root_shift_passes_a_pillar():
+    """A pillar whose face is 0.61 m left of the path: with the CoM over the stance sole's
+    centre, the left gripper meets it in single support on the left foot; a CoM target
+    3 cm inside the sole's edge, nearer the guide, shifts the root less and passes."""
+    terrain = loads_terrain(HEAD + box([3, 0, -0.1], [8, 4, 0.2]) + box([2.0, 0.76, 0.7], [0.3, 0.3, 1.6]))
+    guide = straight(0.0, 4.0)
+    centred = plan_contacts(terrain, guide, DT, GeneratorConfig(single_support_com_inset=None))
+    assert centred.coverage < 0.6
+    plan = plan_contacts(terrain, guide, DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+
+
 def test_turning_too_fast_stops():
     """1.5 rad/s while walking: 0.75 rad per planning pose (stride 5), more than two
     steps can follow (hip yaw 0.35 rad inward); pi/9 rad/s (paper's omega_max) passes."""

@@ -94,6 +94,10 @@ class GeneratorConfig:
     cover_tol: float = 0.005  # m, a sole is covered if the terrain rises more than this above it (DESIGN §6: 5 mm)
     feet_gap: float = 0.01  # m, minimal gap between the two sole rectangles (see edge_margin)
     swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
+    # m: where single support with the CoM over the stance sole's centre fails, the CoM is
+    # aimed instead at the point of that sole, this far inside its edges, nearest the guide
+    # root (a shorter root shift; eval_circuit's pillars). 3 cm leaves twice flat_com_margin. None: off.
+    single_support_com_inset: float | None = 0.03
     min_robustness: float = 1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
     # m, on horizontal faces a CoM this far inside the support polygon is in equilibrium
     # without solving the LP (equilibrium.flat_support_margin); 1.5 cm is ~5 x the CoM
@@ -523,6 +527,12 @@ class ContactGenerator:
         nominal_pos[2] = max(nominal_pos[2], old_pos[2]) + cfg.swing_lift
         lifted.append((nominal_pos, _rotz(pose[3])))
         single = self._posture(pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2])
+        if single is None and cfg.single_support_com_inset is not None:
+            # The root shift that brings the CoM over the sole's centre can put the body into
+            # the terrain (an arm into a pillar beside the path); a CoM target on the sole,
+            # inset from its edges, nearer the guide, needs a shorter shift.
+            nearer = self._sole_point_toward(feet[other], pose[:2], cfg.single_support_com_inset)
+            single = self._posture(pose, index, [stance], air=(side, lifted), com_target=nearer)
         if single is None:
             return None
         ahead = guide[min(index + int(round(cfg.lookahead / timestep)), len(guide) - 1)]
@@ -547,6 +557,20 @@ class ContactGenerator:
                     feet[side] = (pos, rot)
                     return [single, double]
         return None
+
+    @staticmethod
+    def _sole_point_toward(foot, xy, inset: float) -> np.ndarray:
+        """[2] the point of a sole's rectangle shrunk by `inset` (m) nearest to `xy` [2] (world).
+
+        foot: (pos [3], rot [3, 3]) world sole placement; the rectangle is taken in its yaw frame.
+        """
+        pos, rot = foot
+        yaw = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx, dy = float(xy[0]) - float(pos[0]), float(xy[1]) - float(pos[1])
+        u = min(max(c * dx + s * dy, -(SOLE_LENGTH / 2 - inset)), SOLE_LENGTH / 2 - inset)
+        v = min(max(-s * dx + c * dy, -(SOLE_WIDTH / 2 - inset)), SOLE_WIDTH / 2 - inset)
+        return np.array([float(pos[0]) + c * u - s * v, float(pos[1]) + s * u + c * v])
 
     def double_support(self, pose) -> ContactPosture | None:
         """The first posture of a plan whose guide starts at `pose`, or None.

@@ -41,12 +41,13 @@ class ReachabilityConfig:
     the shipped policy).
     The generator of eaca5fb walks crouched (a bug had put the lifted swing foot
     underground below a 0.85 m root): on flat ground it now walks with the root
-    0.80-1.15 m up (benchmarks/walking_height.py), and 2537 of the 12 000 poses are
-    feasible instead of 2027. Against it these defaults give sensitivity 82.3 %,
-    specificity 84.5 % (447 of the 450 rejected feasible poses are crouched ones that
-    fail the trunk term: median 0.785 m above the ground under the trunk); the search's
-    best at >= 95 % sensitivity on the fitting poses (trunk bottom -0.75, leg top -0.775)
-    gives 94.3 / 80.9 % on all poses. The defaults are kept: a false positive is a guide the generator cannot
+    0.80-1.15 m up (benchmarks/walking_height.py). With it and the single-support
+    fallback of 88edab8, 2632 of the 12 000 poses are feasible instead of 2027, and
+    these defaults give sensitivity 81.2 %, specificity 84.9 %. The feasible poses they
+    reject are crouched ones (with eaca5fb alone, 447 of 450 failed the trunk term,
+    median 0.785 m above the ground under the trunk). The search's best at >= 95 %
+    sensitivity on the fitting poses (trunk r 0.25, bottom -0.75, leg top -0.775) gives
+    94.6 / 80.1 % on all poses. The defaults are kept: a false positive is a guide the generator cannot
     follow, a false negative only keeps the policy higher than it needs to be (the
     generator walks there too), and the shipped policy was trained with them.
     """

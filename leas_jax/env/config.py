@@ -15,41 +15,22 @@ class ReachabilityConfig:
     """Cylinders of the reachability condition, root frame (origin at base_link, z up, yaw only).
 
     DESIGN.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
-    Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]).
-    The defaults below are calibrated by benchmarks/reachability_calibration.py
-    against the contact generator *walking*: a pose is feasible when the generator
-    covers a 0.36 m straight guide from it (`--truth walking`, 12 000 poses of
-    terrains/training_arena.toml): sensitivity 95.1 %, specificity 81.7 % (DESIGN §5
-    values: 69.3 % / 62.9 %). The first calibration used a static double-support
-    posture as the truth (`--truth static`, the issue's definition); Talos can crouch
-    to 0.53 m above its soles for that, so it chose trunk_bottom -0.525, and policies
-    trained with it climbed stairs crouched 0.72-0.84 m above the step, where the
-    generator does not walk (benchmarks/walking_height.py: on flat ground it needs
-    the root >= 0.90 m up; on the 0.12 m stairs about 1.0 m above the highest ground
-    within 0.15 m). No setting reaches 90 % specificity at 95 % sensitivity with
-    either truth. The search's best by its ranking (trunk r 0.20 m, bottom -0.85) is
-    0.3 points of specificity ahead on the fitting poses, a tie: the trunk keeps
-    DESIGN §5's 0.30 m radius. Against the static truth these defaults give
-    sensitivity 56.0 %, specificity 89.6 % (the crouched postures count as feasible there).
-    The walking truth above predates the generator's 5 mm sole-edge margin (commit 157e3f5),
-    7 cm step trigger and beam-aligned soles (fb311e9). Recomputed with the generator of
-    fb311e9 (`python benchmarks/reachability_calibration.py --truth walking`, 2026-11-22),
-    these defaults give sensitivity 95.0 %, specificity 83.7 % (all poses; held-out
-    94.0 / 84.6 %). The best cylinders alone reach 94.7 / 85.1 %; with the optional
-    lookahead and foothold terms below (off by default) 94.4 / 88.1 % (fitting poses
-    95.1 / 87.8 %): still short of 90 %, so the defaults stay (changing them retrains
-    the shipped policy).
-    The generator of eaca5fb walks crouched (a bug had put the lifted swing foot
-    underground below a 0.85 m root): on flat ground it now walks with the root
-    0.80-1.15 m up (benchmarks/walking_height.py). With it and the single-support
-    fallback of 88edab8, 2632 of the 12 000 poses are feasible instead of 2027, and
-    these defaults give sensitivity 81.2 %, specificity 84.9 %. The feasible poses they
-    reject are crouched ones (with eaca5fb alone, 447 of 450 failed the trunk term,
-    median 0.785 m above the ground under the trunk). The search's best at >= 95 %
-    sensitivity on the fitting poses (trunk r 0.25, bottom -0.75, leg top -0.775) gives
-    94.6 / 80.1 % on all poses. The defaults are kept: a false positive is a guide the generator cannot
-    follow, a false negative only keeps the policy higher than it needs to be (the
-    generator walks there too), and the shipped policy was trained with them.
+    Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]). The
+    defaults below were calibrated by benchmarks/reachability_calibration.py against
+    the contact generator *walking* (`--truth walking`: a pose is feasible when the
+    generator covers a 0.36 m straight guide from it; 12 000 poses of
+    terrains/training_arena.toml). The static truth (one double-support posture, the
+    issue's definition) let the root down to 0.525 m, where the generator does not walk.
+
+    Against the current generator, which walks with the root 0.80-1.15 m above flat
+    ground (benchmarks/walking_height.py), these defaults give sensitivity 81.2 %,
+    specificity 84.9 %; the feasible poses they reject are crouched ones. The best
+    setting at >= 95 % sensitivity gives 94.6 / 80.1 % (94.9 / 83.7 % with the optional
+    lookahead and foothold terms below). No setting reaches 90 % specificity at 95 %
+    sensitivity. The defaults are kept: a false positive is a guide the generator cannot
+    follow, a false negative only keeps the policy higher than it needs to be, and the
+    shipped policy was trained with them. The README's "Contact generator" section has
+    the history of these figures.
     """
 
     # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)

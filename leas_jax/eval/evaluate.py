@@ -338,9 +338,9 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
             path, as it judges the baselines' paths, which nothing cuts either (the
             paper's RBLin paths "lead inside the hole", §IV-B.2). The condition is a
             training proxy of the generator (benchmarks/reachability_calibration.py:
-            ~84 % specificity, and it rejects poses the generator walks through: 5 of
-            the shipped policy's 10 circuit paths end at a rejected pose on a step
-            down that the generator then walks).
+            ~85 % specificity, and it rejects poses the generator walks through: 8 of
+            the shipped policy's 10 circuit paths meet a rejected pose on a step down
+            that the generator then walks).
 
     Returns:
         the results dictionary written to results.json.

@@ -237,13 +237,15 @@ def test_slow_leas_climb_of_eval_stairs_is_covered():
 
 
 def test_soles_turn_to_a_narrow_bridge_axis():
-    """Crossing the 0.30 m bridge with the root turned 0.2 rad off its axis: soles at the
-    guide's yaw do not fit side by side (2 x 0.152 m across), soles turned to the beam's
-    axis do; with the turning disabled the plan stops on the bridge."""
+    """Crossing the 0.30 m bridge with the root turned 0.3 rad off its axis: soles at the
+    guide's yaw take 0.183 m across each, so they fit only staggered; soles turned to the
+    beam's axis fit; with the turning disabled this plan stops on the bridge. (At 0.2 rad
+    staggered soles at the guide's yaw cross too, once a sole may rest across the
+    platform's and the bridge's coplanar tops.)"""
     bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
                            + box([5.5, 0, -0.1], [3, 4, 0.2]))
     guide = straight(0.0, 5.0)
-    guide[:, 3] = 0.2
+    guide[:, 3] = 0.3
     plan = plan_contacts(bridge, guide, DT)
     assert plan.coverage == 1.0
     assert verify(plan).ok
@@ -254,3 +256,30 @@ def test_soles_turn_to_a_narrow_bridge_axis():
     stiff = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0))
     assert stiff.coverage < 1.0
     assert 2.0 < x_at(stiff, stiff.last_valid_index) < 4.0
+
+
+def test_ground_of_narrow_coplanar_boxes_is_walked():
+    """Flat ground built from 0.10 m wide boxes along the guide, narrower than a sole
+    (0.13 m): no sole fits inside one box's top; soles rest across their coplanar tops."""
+    strips = "".join(box([3, y, -0.1], [8, 0.1, 0.2]) for y in np.arange(-1.95, 2.0, 0.1))
+    plan = plan_contacts(loads_terrain(HEAD + strips), straight(0.0, 2.0), DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+
+
+def test_start_on_rubble_tries_other_soles():
+    """A training-arena start on rubble tiles (the pose of a shipped-policy-like rollout):
+    the best candidate of each foot gives a stance that fails its checks; a pair of
+    lower-ranked candidates stands, and the one-posture plan passes `verify`."""
+    from leas_jax.contacts.generator import LEFT, RIGHT
+    from leas_jax.terrain import load_terrain
+
+    arena = load_terrain(Path(__file__).parents[1] / "terrains" / "training_arena.toml")
+    pose = np.array([2.715, 7.48, 1.046, 2.169])
+    generator = ContactGenerator(arena)
+    left = generator._first_candidate(LEFT, pose, *generator._nominal_placement(pose, LEFT))
+    right = generator._first_candidate(RIGHT, pose, *generator._nominal_placement(pose, RIGHT), left)
+    assert generator._posture(pose, 0, [(LEFT, *left), (RIGHT, *right)]) is None
+    plan = plan_contacts(arena, pose[None], DT)
+    assert plan.last_valid_index == 0 and len(plan.q) == 1
+    assert verify(plan).ok

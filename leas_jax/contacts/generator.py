@@ -43,7 +43,7 @@ from leas_jax.contacts.ik import leg_ik, leg_ik_single
 from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
                                      load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
-from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corners_world, sole_rotation,
+from leas_jax.contacts.surfaces import (SOLE_CORNERS, sole_corners_world, sole_inside_union, sole_rotation,
                                         sole_rotation_single, surface_arrays, uncovered)
 from leas_jax.errors import UsageError
 
@@ -156,7 +156,6 @@ class ContactGenerator:
                        for leg in legs]
         self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
         self._nominal_xy = [tuple(row[:2].tolist()) for row in self._nominal]
-        self._faces = {}  # face index -> (inward edge normals [E, 3], offsets [E])
         self._beam_axes = {}  # face index -> [A] yaws (rad) of the edges it is narrower than beam_width across
         # Diagnostics: postures built, candidates that passed the cover and reach tests
         # (those screened: `_step` screens its candidates lazily).
@@ -347,9 +346,14 @@ class ContactGenerator:
         reach = cfg.candidate_radius + 0.5 * math.hypot(SOLE_LENGTH, SOLE_WIDTH)
         near = np.nonzero(np.all((surfaces.bbox[:, 0, :2] - reach <= target_pos[:2]) &
                                  (surfaces.bbox[:, 1, :2] + reach >= target_pos[:2]), axis=1))[0]
-        points, owner, rotations = [], [], []
+        points, pending, owner, rotations, faces = [], [], [], [], []
         disk_xy, disk = None, None  # the samples' (x, y) test is the same for every face
+        done = set()  # (coplanar group, sole yaw): its faces give the same candidates
         for s in near:
+            yaws = [yaw for yaw in self._sole_yaws(s, target_yaw) if (surfaces.group[s], yaw) not in done]
+            if not yaws:
+                continue
+            done.update((surfaces.group[s], yaw) for yaw in yaws)
             normal = surfaces.normals[s]
             # Vertical projection of the target on the face plane: itself a candidate.
             height = (surfaces.offsets[s] - normal[:2] @ target_pos[:2]) / normal[2]
@@ -364,38 +368,49 @@ class ContactGenerator:
             # Database samples in a vertical column about the target, dropped vertically
             # on the face (reachability is re-checked exactly by IK below).
             world[:, 2] = (surfaces.offsets[s] - world[:, :2] @ normal[:2]) / normal[2]
-            for yaw in self._sole_yaws(s, target_yaw):
+            grouped = len(surfaces.members[surfaces.group[s]]) > 1
+            for yaw in yaws:
                 rot = sole_rotation_single(normal, yaw)
                 inside = self._inside_face(s, world, rot)
-                points.append(world[inside])
-                owner.append(np.full(int(inside.sum()), len(rotations)))
+                # Outside face s alone, a sole may still lie inside its coplanar group's
+                # union: tested below, lazily (costlier), on the closest ones only.
+                keep = np.ones(len(world), dtype=bool) if grouped else inside
+                points.append(world[keep])
+                pending.append(~inside[keep])
+                owner.append(np.full(int(keep.sum()), len(rotations)))
                 rotations.append(rot)
+                faces.append(s)
         if not points:
             return empty
         pos = np.concatenate(points)
-        owner = np.concatenate(owner)  # index into `rotations`: one per (face, sole yaw)
+        pending = np.concatenate(pending)
+        owner = np.concatenate(owner)  # index into `rotations` and `faces`: one per (group, sole yaw)
         # Stable: at equal distances the guide's yaw comes before the beam's (appended after it).
         order = np.argsort(np.hypot(pos[:, 0] - target_pos[0], pos[:, 1] - target_pos[1]), kind="stable")
-        pos, owner = pos[order], owner[order]
-        # One candidate per grid cell, face and sole yaw (database samples cluster; coplanar
-        # neighbouring faces share dropped samples), the closest to the target.
+        pos, owner, pending = pos[order], owner[order], pending[order]
+        # One candidate per grid cell, group and sole yaw (database samples cluster), the
+        # closest to the target.
         cells = np.round((pos[:, :2] - target_pos[:2]) / cfg.candidate_grid).astype(np.int64) + 1000
         key = (cells[:, 0] * 2000 + cells[:, 1]) * (len(rotations) + 1) + owner
         _, first = np.unique(key, return_index=True)
         keep = np.sort(first)
-        pos, owner = pos[keep], owner[keep]
+        pos, owner, pending = pos[keep], owner[keep], pending[keep]
         rot = np.stack(rotations)[owner]
-        ok = np.ones(len(pos), dtype=bool)
+        # Row-wise tests (union, overlap), on a prefix first: only the closest `limit`
+        # passing ones are kept, and go through the costlier tests of `_screen`.
         limit = 4 * cfg.max_candidates
-        if avoid is not None and len(pos):
-            # Row-wise test, on a prefix first: only the closest `limit` passing ones are kept.
-            ok[:] = False
-            start = 0
-            while start < len(pos) and int(ok.sum()) < limit:
-                stop = min(len(pos), start + 2 * limit)
-                ok[start:stop] = ~self._overlaps(pos[start:stop], rot[start:stop], *avoid)
-                start = stop
-        # The closest few go through the costlier tests.
+        ok = np.zeros(len(pos), dtype=bool)
+        start = 0
+        while start < len(pos) and int(ok.sum()) < limit:
+            stop = min(len(pos), start + 2 * limit)
+            passed = ~pending[start:stop]
+            for k in np.unique(owner[start:stop][~passed]):
+                rows = np.flatnonzero(pending[start:stop] & (owner[start:stop] == k))
+                passed[rows] = self._inside_group(faces[k], pos[start + rows], rotations[k])
+            if avoid is not None:
+                passed &= ~self._overlaps(pos[start:stop], rot[start:stop], *avoid)
+            ok[start:stop] = passed
+            start = stop
         ok[np.cumsum(ok) > limit] = False
         return pos[ok], rot[ok]
 
@@ -454,16 +469,21 @@ class ContactGenerator:
         shrunk, edge by edge, by the rectangle's half-extent along the edge's inward
         normal m: |m . x_sole| L/2 + |m . y_sole| W/2 (one matrix product for all centres).
         """
-        if s not in self._faces:
-            face = self.surfaces.surfaces[s]
-            verts = face.vertices
-            inward = np.cross(face.normal, np.roll(verts, -1, axis=0) - verts)
-            inward /= np.linalg.norm(inward, axis=1, keepdims=True)
-            self._faces[s] = (inward, np.einsum("ei,ei->e", inward, verts))
-        inward, offsets = self._faces[s]
+        inward, offsets = self.surfaces.edges[s]
         extent = np.abs(inward @ rot[:, 0]) * SOLE_LENGTH / 2 + np.abs(inward @ rot[:, 1]) * SOLE_WIDTH / 2
         bound = offsets + extent + self.config.edge_margin
         return np.all(centres @ inward.T >= bound, axis=1)
+
+    def _inside_group(self, s: int, centres: np.ndarray, rot: np.ndarray) -> np.ndarray:
+        """[N] whether soles with centres [N, 3] on face s and orientation rot [3, 3] lie inside
+        the union of its coplanar group (`surfaces.sole_inside_union`), `edge_margin` from the
+        union's edges, tested against the group's faces near them."""
+        members = self.surfaces.members[self.surfaces.group[s]]
+        reach = 0.5 * math.hypot(SOLE_LENGTH, SOLE_WIDTH) + self.config.edge_margin
+        lo, hi = centres[:, :2].min(axis=0) - reach, centres[:, :2].max(axis=0) + reach
+        box = self.surfaces.bbox[members]
+        near = members[np.all((box[:, 0, :2] <= hi) & (box[:, 1, :2] >= lo), axis=1)]
+        return sole_inside_union(self.surfaces, near, centres, rot, self.config.edge_margin)
 
     def _overlaps(self, pos, rot, other_pos, other_rot) -> np.ndarray:
         """[N] whether sole rectangles (pos [N,3], rot [N,3,3]) come within feet_gap of another sole.
@@ -591,21 +611,42 @@ class ContactGenerator:
         return None if start is None else start[1]
 
     def _initial(self, guide) -> tuple[list, _Posture] | None:
-        """Initial stance at guide pose 0: feet at their nominal places moved onto faces."""
+        """Initial stance at guide pose 0: feet at their nominal places moved onto faces.
+
+        The best candidate of each foot first (the right one's avoids the left one); if
+        that stance fails a check (a sole across a rubble tile's edge tilts the legs
+        out of balance), pairs of lower-ranked candidates, by increasing rank sum,
+        up to `max_candidates` stances in all.
+        """
         pose = guide[0]
-        feet = [None, None]
-        for side in (LEFT, RIGHT):
-            target, yaw = self._nominal_placement(pose, side)
-            avoid = feet[1 - side] if feet[1 - side] is not None else None
-            first = self._first_candidate(side, pose, target, yaw, avoid)
-            if first is None:
-                return None
-            feet[side] = first
-        contacts = [(side, feet[side][0], feet[side][1]) for side in (LEFT, RIGHT)]
-        posture = self._posture(pose, 0, contacts)
-        if posture is None:
+        left_target, left_yaw = self._nominal_placement(pose, LEFT)
+        right_target, right_yaw = self._nominal_placement(pose, RIGHT)
+        left = self._first_candidate(LEFT, pose, left_target, left_yaw)
+        if left is None:
             return None
-        return feet, posture
+        right = self._first_candidate(RIGHT, pose, right_target, right_yaw, left)
+        if right is None:
+            return None
+        posture = self._posture(pose, 0, [(LEFT, *left), (RIGHT, *right)])
+        if posture is not None:
+            return [left, right], posture
+        lefts = list(zip(*self.candidates(LEFT, pose, left_target, left_yaw)))
+        rights = {}  # left rank -> right candidates avoiding that left sole
+        pairs = sorted(((i, j) for i in range(len(lefts)) for j in range(self.config.max_candidates)),
+                       key=lambda ij: (ij[0] + ij[1], ij[0]))
+        tried = 0
+        for i, j in pairs[1:]:
+            if i not in rights:
+                rights[i] = list(zip(*self.candidates(RIGHT, pose, right_target, right_yaw, lefts[i])))
+            if j >= len(rights[i]):
+                continue
+            if tried == self.config.max_candidates:
+                break
+            tried += 1
+            posture = self._posture(pose, 0, [(LEFT, *lefts[i]), (RIGHT, *rights[i][j])])
+            if posture is not None:
+                return [lefts[i], rights[i][j]], posture
+        return None
 
     def plan(self, guide, timestep: float) -> ContactPlan:
         """Contact plan along a guide path (see the module docstring).

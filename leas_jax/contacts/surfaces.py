@@ -4,6 +4,15 @@ Host-only (NumPy), not jittable. Wraps `Terrain.support_surfaces(mu)` (box faces
 normal is within the friction cone) with what the generator and the verifier need:
 plane equations, polygon edges, bounding boxes, the sole orientation on a face and
 the "sole rectangle inside the face polygon" test of DESIGN §6 check 1.
+
+A terrain face, for that test, is the union of the box faces of one plane that touch
+(`SurfaceArrays.group`): a sole may rest across two coplanar boxes, as on the
+training arena's ground, which is tiled from one box per free rectangle of each cell.
+HPP's affordance extraction, which the paper's planner uses, likewise merges adjacent
+coplanar triangles into one surface. Each box face alone stays convex, so a sole inside
+one face is tested exactly; across faces the test samples the sole rectangle (edges
+every `UNION_EDGE_STEP`, inside every `UNION_INNER_STEP`): a gap narrower than that
+between two faces of one plane could go unseen (the terrains' gaps are >= 0.15 m).
 """
 
 from __future__ import annotations
@@ -20,6 +29,13 @@ from leas_jax.contacts.model import SOLE_LENGTH, SOLE_WIDTH
 SOLE_CORNERS = np.array([[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0]
                          for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
 
+COPLANAR_NORMAL_TOL = 1e-6  # |n_a - n_b| below which two faces have the same normal
+COPLANAR_OFFSET_TOL = 1e-5  # m, |offset_a - offset_b| below which they lie in one plane
+TOUCH_TOL = 1e-3  # m, bounding boxes this close count as touching (grouping only)
+UNION_EDGE_STEP = 0.02  # m, spacing of the sample points along the sole rectangle's edges (the raster's)
+UNION_INNER_STEP = 0.04  # m, spacing of the sample points inside it
+_INSIDE_TOL = 1e-6  # m, a sample point on a shared edge lies inside both faces
+
 
 @dataclass(frozen=True)
 class SurfaceArrays:
@@ -30,12 +46,21 @@ class SurfaceArrays:
         normals: [S, 3] unit outward normals.
         offsets: [S] plane offsets n . v0 (points x on the plane have n . x = offset).
         bbox: [S, 2, 3] axis-aligned bounds of each polygon, world.
+        group: [S] coplanar group of each face: faces of one plane whose bounding
+            boxes touch, transitively (`coplanar_groups`).
+        members: per group, the sorted indices of its faces.
+        edges: per face, (inward [E, 3], bounds [E]): the unit inward normals of its
+            polygon's edges, in its plane, and inward . v_k; a point p on or near the
+            plane is `m` inside edge k iff inward_k . p >= bounds_k + m.
     """
 
     surfaces: tuple
     normals: np.ndarray
     offsets: np.ndarray
     bbox: np.ndarray
+    group: np.ndarray
+    members: tuple
+    edges: tuple
 
     def __len__(self) -> int:
         return len(self.surfaces)
@@ -52,8 +77,108 @@ def surface_arrays(terrain, mu: float) -> SurfaceArrays:
         normals = np.array([s.normal for s in surfaces]).reshape(-1, 3)
         offsets = np.array([float(s.normal @ s.vertices[0]) for s in surfaces])
         bbox = np.array([[s.vertices.min(axis=0), s.vertices.max(axis=0)] for s in surfaces]).reshape(-1, 2, 3)
-        per_terrain[mu] = SurfaceArrays(surfaces, normals, offsets, bbox)
+        group = coplanar_groups(normals, offsets, bbox)
+        members = tuple(np.flatnonzero(group == g) for g in range(int(group.max(initial=-1)) + 1))
+        edges = tuple(_edge_normals(s) for s in surfaces)
+        per_terrain[mu] = SurfaceArrays(surfaces, normals, offsets, bbox, group, members, edges)
     return per_terrain[mu]
+
+
+def _edge_normals(surface) -> tuple[np.ndarray, np.ndarray]:
+    """(inward [E, 3], bounds [E]) of a face's polygon edges (see `SurfaceArrays.edges`)."""
+    verts = surface.vertices
+    inward = np.cross(surface.normal, np.roll(verts, -1, axis=0) - verts)
+    inward /= np.linalg.norm(inward, axis=1, keepdims=True)
+    return inward, np.einsum("ei,ei->e", inward, verts)
+
+
+def coplanar_groups(normals: np.ndarray, offsets: np.ndarray, bbox: np.ndarray) -> np.ndarray:
+    """Connected components of the faces that share a plane and whose bounding boxes touch.
+
+    Touching bounding boxes are necessary, not sufficient, for touching polygons (a
+    rotated face's box is larger than it): a group is only the set of faces that
+    `sole_inside_union` tests together, each sample point against the real polygons.
+
+    Args:
+        normals: [S, 3] unit normals; offsets: [S] plane offsets; bbox: [S, 2, 3] bounds.
+
+    Returns:
+        [S] int group ids, numbered in order of each group's first face.
+    """
+    count = len(normals)
+    parent = np.arange(count)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i in range(count):
+        same_plane = ((np.linalg.norm(normals[i + 1:] - normals[i], axis=1) < COPLANAR_NORMAL_TOL)
+                      & (np.abs(offsets[i + 1:] - offsets[i]) < COPLANAR_OFFSET_TOL))
+        touching = np.all((bbox[i + 1:, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[i + 1:, 1] >= bbox[i, 0] - TOUCH_TOL),
+                          axis=1)
+        for j in i + 1 + np.flatnonzero(same_plane & touching):
+            a, b = root(i), root(int(j))
+            if a != b:
+                parent[max(a, b)] = min(a, b)
+    roots = np.array([root(i) for i in range(count)], dtype=np.int64)
+    _, first, ids = np.unique(roots, return_index=True, return_inverse=True)
+    order = np.argsort(np.argsort(first))  # renumber by first face
+    return order[ids].reshape(-1)
+
+
+def _sole_samples(grow: float) -> np.ndarray:
+    """[P, 3] points of the sole rectangle grown by `grow` (m) on every side, sole frame:
+    its edges every <= UNION_EDGE_STEP (corners included) and inside every <= UNION_INNER_STEP."""
+    half = np.array([SOLE_LENGTH / 2 + grow, SOLE_WIDTH / 2 + grow])
+    edge = [np.linspace(-h, h, int(math.ceil(2 * h / UNION_EDGE_STEP)) + 1) for h in half]
+    inner = [np.linspace(-h, h, int(math.ceil(2 * h / UNION_INNER_STEP)) + 1)[1:-1] for h in half]
+    border = np.concatenate([np.stack([edge[0], np.full_like(edge[0], sy * half[1])], axis=1) for sy in (-1, 1)]
+                            + [np.stack([np.full_like(edge[1], sx * half[0]), edge[1]], axis=1) for sx in (-1, 1)])
+    grid = np.stack(np.meshgrid(*inner, indexing="ij"), axis=-1).reshape(-1, 2)
+    points = np.unique(np.round(np.concatenate([border, grid]), 12), axis=0)
+    return np.concatenate([points, np.zeros((len(points), 1))], axis=1)
+
+
+_SAMPLES: dict = {}
+
+
+def sole_inside_union(surfaces: "SurfaceArrays", faces, pos, rot, margin: float) -> np.ndarray:
+    """Whether sole rectangles lie inside the union of some faces of one plane, `margin` from its edges.
+
+    Every sample point of the rectangle grown by `margin` (`_sole_samples`) must lie in
+    one of the polygons. The four corners are tested first, on all soles; the other
+    points only on the soles whose corners passed.
+
+    Args:
+        surfaces: the terrain's SurfaceArrays.
+        faces: indices of the faces (one plane).
+        pos: [N, 3] sole centres, world (on the plane); rot: [3, 3] or [N, 3, 3] world_R_sole.
+        margin: distance kept from the union's edges, m (negative: tolerance outside).
+
+    Returns:
+        [N] bool.
+    """
+    pos = np.asarray(pos, dtype=np.float64).reshape(-1, 3)
+    rot = np.broadcast_to(np.asarray(rot, dtype=np.float64), (len(pos), 3, 3))
+    if margin not in _SAMPLES:
+        _SAMPLES[margin] = _sole_samples(margin)
+    samples = _SAMPLES[margin]
+    corners = np.abs(np.abs(samples[:, :2]) - np.abs(samples[:, :2]).max(axis=0)).max(axis=1) < 1e-12
+    ok = np.ones(len(pos), dtype=bool)
+    for subset in (samples[corners], samples[~corners]):
+        idx = np.flatnonzero(ok)
+        if len(idx) == 0:
+            break
+        points = (pos[idx, None, :] + np.einsum("nij,pj->npi", rot[idx], subset)).reshape(-1, 3)  # [n P, 3]
+        covered = np.zeros(len(points), dtype=bool)
+        for s in faces:
+            inward, bounds = surfaces.edges[s]
+            covered |= np.all(points @ inward.T >= bounds - _INSIDE_TOL, axis=1)
+        ok[idx] = covered.reshape(len(idx), -1).all(axis=1)
+    return ok
 
 
 def sole_rotation(normal, yaw) -> np.ndarray:
@@ -263,25 +388,33 @@ def find_support(terrain, surfaces: SurfaceArrays, pos, rot, dist_tol: float, an
         edge_tol: how far the sole corners may stick out of the polygon, m.
 
     Returns:
-        (surface index, "") when found, else (-1, reason naming the closest face).
+        (surface index, "") when found (a face of the sole's coplanar group; the sole
+        lies inside the group's union, see the module docstring), else (-1, reason
+        naming the closest face).
     """
     del terrain
     pos = np.asarray(pos, dtype=np.float64)
+    rot = np.asarray(rot, dtype=np.float64)
     if len(surfaces) == 0:
         return -1, "the terrain has no support surface"
-    corners = sole_corners_world(pos[None], np.asarray(rot)[None])[0]
+    corners = sole_corners_world(pos[None], rot[None])[0]
     dist = surfaces.normals @ pos - surfaces.offsets
     cos_angle = np.clip(surfaces.normals @ rot[:, 2], -1.0, 1.0)
     angle = np.arccos(cos_angle)
     best_reason, best_score = "", np.inf
+    on_plane = (np.abs(dist) <= dist_tol) & (angle <= angle_tol)
     for s in np.argsort(np.abs(dist)):
         surface = surfaces.surfaces[s]
         inside = inside_polygon(surface, corners, -edge_tol)
-        if abs(dist[s]) <= dist_tol and angle[s] <= angle_tol and inside.all():
+        if on_plane[s] and inside.all():
             return int(s), ""
         score = abs(dist[s]) + angle[s] + (0 if inside.all() else 1.0)
         if score < best_score:
             best_score = score
             best_reason = (f"closest face (box {surface.box_index}): plane distance {1000 * dist[s]:.1f} mm, "
                            f"tilt {np.degrees(angle[s]):.2f} deg, {int((~inside).sum())} sole corners outside")
+    for group in np.unique(surfaces.group[on_plane]):
+        members = surfaces.members[group]
+        if len(members) > 1 and sole_inside_union(surfaces, members, pos, rot, -edge_tol)[0]:
+            return int(members[0]), ""
     return -1, "sole not on a support surface; " + best_reason

@@ -33,7 +33,9 @@ search (`TERMS_GRID`) adds the lookahead leg cylinders (`leg_forward`) and the f
 flatness term (`foothold_radius`, `foothold_search`, `foothold_spread`) of
 `leas_jax.env.reachability` to the thresholds above, on fewer radii (they cost a
 raster per setting); both bests are reported, and the NumPy form of each is checked
-against the jitted condition.
+against the jitted condition. A third search (`HANDS_GRID`) adds the hands term
+(`hand_radius`, `hand_bottom`: the half-sitting grippers beside the trunk cylinder) to
+the setting the second one chose, with the same thresholds grid.
 
 Selection: parameters that keep a root at 1.0 m and at NOMINAL_ROOT_HEIGHT (1.019 m)
 above flat ground valid with >= 2 cm margins (the environment's spawn logic needs it);
@@ -98,6 +100,13 @@ TERMS_GRID = {
     "leg_forward": (0.0, 0.06, 0.12, 0.18, 0.24),
     "foothold": (None, (0.065, 0.10), (0.08, 0.10), (0.10, 0.10)),
     "foothold_spread": (0.01, 0.02, 0.04),
+}
+# Grid of the hands term (`hand_radius`, `hand_bottom`; hand centres at the defaults of
+# ReachabilityConfig, from the model's grippers), searched with the thresholds of GRID on
+# the radii, lookahead and foothold chosen by the search with TERMS_GRID. None: term off.
+HANDS_GRID = {
+    "hand": (None, 0.10, 0.13, 0.16),
+    "hand_bottom": (-0.45, -0.40, -0.35, -0.30),
 }
 
 
@@ -258,31 +267,34 @@ def condition(terrain, poses: np.ndarray, config) -> np.ndarray:
 
 
 def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: float,
-                   leg_lateral_offset: float, leg_forward: float = 0.0, foothold=None) -> dict:
+                   leg_lateral_offset: float, leg_forward: float = 0.0, foothold=None, hand_radius=None) -> dict:
     """What the condition reads, per pose, for one set of radii (jitted, vmapped).
 
     Args:
         terrain: a leas_jax.terrain.Terrain; poses: [N, 4] (x, y, z, yaw), world.
         trunk_radius, leg_radius, leg_lateral_offset, leg_forward: ReachabilityConfig fields, m.
         foothold: None (term off) or (foothold_radius, foothold_search), m.
+        hand_radius: None (term off) or the hands term's radius, m (centres: ReachabilityConfig's).
 
     Returns:
         dict of float32 arrays: z [N], trunk [N] (trunk_max at the root), leg_max and
         leg_min [N, L] (at the leg centres of `reachability.all_leg_centers`: left, right,
-        then left and right ahead when leg_forward != 0, L = 2 or 4) and, with the
-        foothold term, foothold [N, L] (the foothold raster at those centres).
+        then left and right ahead when leg_forward != 0, L = 2 or 4), with the
+        foothold term, foothold [N, L] (the foothold raster at those centres) and, with
+        the hands term, hand [N, 2] (hand_max at the left and right hand centres).
     """
     import jax
     import jax.numpy as jnp
 
     from leas_jax.env import EnvConfig, ReachabilityConfig
     from leas_jax.env.field import heightfield_from_raster, sample_nearest
-    from leas_jax.env.reachability import all_leg_centers
+    from leas_jax.env.reachability import all_leg_centers, hand_centers
 
     extra = {} if foothold is None else {"foothold_radius": foothold[0], "foothold_search": foothold[1],
                                          "foothold_spread": 0.0}  # any value: builds the raster
     config = ReachabilityConfig(trunk_radius=trunk_radius, leg_radius=leg_radius,
-                                leg_lateral_offset=leg_lateral_offset, leg_forward=leg_forward, **extra)
+                                leg_lateral_offset=leg_lateral_offset, leg_forward=leg_forward,
+                                hand_radius=hand_radius, **extra)
     # The environment's own rasters (the void is no floor for the legs); spawn points are
     # not needed here, and the grid visits radii where there may be none.
     field = heightfield_from_raster(terrain.raster(), terrain.bounds[0], terrain.resolution, terrain.void_height,
@@ -292,24 +304,29 @@ def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: 
         legs = all_leg_centers(pose, config)
         return (sample_nearest(f, f.trunk_max, pose[:2]), sample_nearest(f, f.leg_max, legs, outside=-jnp.inf),
                 sample_nearest(f, f.leg_min, legs, outside=jnp.inf),
-                sample_nearest(f, f.foothold, legs, outside=jnp.inf) if foothold is not None else jnp.zeros(0))
+                sample_nearest(f, f.foothold, legs, outside=jnp.inf) if foothold is not None else jnp.zeros(0),
+                sample_nearest(f, f.hand_max, hand_centers(pose, config), outside=-jnp.inf)
+                if hand_radius is not None else jnp.zeros(0))
 
     poses32 = jnp.asarray(poses, dtype=jnp.float32)
-    trunk, leg_max, leg_min, flat = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
+    trunk, leg_max, leg_min, flat, hand = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
     out = {"z": np.asarray(poses32[:, 2]), "trunk": np.asarray(trunk), "leg_max": np.asarray(leg_max),
            "leg_min": np.asarray(leg_min)}
     if foothold is not None:
         out["foothold"] = np.asarray(flat)
+    if hand_radius is not None:
+        out["hand"] = np.asarray(hand)
     return out
 
 
-def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top, foothold_spread=None) -> np.ndarray:
+def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top, foothold_spread=None, hand_bottom=None) -> np.ndarray:
     """The condition of `reachability.terms` from `raster_samples`, for many thresholds at once.
 
     Args:
         samples: raster_samples output (N poses, L leg centres).
         trunk_bottom, leg_bottom, leg_top: [...] broadcastable threshold arrays, m.
         foothold_spread: None (term off) or a scalar, m (needs samples["foothold"]).
+        hand_bottom: None (term off) or a scalar, m (needs samples["hand"]).
 
     Returns:
         [..., N] bool (float32 arithmetic, as in the jitted condition).
@@ -322,6 +339,8 @@ def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top, foothold_spread
         result = result & (samples["leg_max"][:, k] >= z + lb) & (samples["leg_min"][:, k] <= z + lt)
     if foothold_spread is not None:
         result = result & np.all(samples["foothold"] <= f(foothold_spread), axis=1)
+    if hand_bottom is not None:
+        result = result & np.all(samples["hand"] < (z + f(hand_bottom))[:, None], axis=1)
     return result
 
 
@@ -372,7 +391,8 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
             leg_radius) to search.
         terms_grid: None (the optional terms keep base_config's values), or a dict like
             TERMS_GRID whose radii replace grid's and whose leg_forward, foothold and
-            foothold_spread values are searched too.
+            foothold_spread values are searched too, and the hands term's `hand` (radius
+            or None) and `hand_bottom` values when it has them (else base_config's).
 
     Returns:
         dict: config (the chosen ReachabilityConfig), met (targets met on the fitting
@@ -383,23 +403,27 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
     tb, lb, lt = tb.ravel(), lb.ravel(), lt.ravel()
     allowed = flat_ground_ok(tb, lb, lt)
     tb, lb, lt = tb[allowed], lb[allowed], lt[allowed]
+    hands = (base_config.hand_radius,) if terms_grid is None else terms_grid.get("hand", (base_config.hand_radius,))
+    hand_bottoms = (base_config.hand_bottom,) if terms_grid is None else terms_grid.get("hand_bottom",
+                                                                                       (base_config.hand_bottom,))
     if terms_grid is None:
         radii = itertools.product(grid["trunk_radius"], grid["leg_radius"], (base_config.leg_forward,),
                                   (None if base_config.foothold_spread is None else
-                                   (base_config.foothold_radius, base_config.foothold_search),))
+                                   (base_config.foothold_radius, base_config.foothold_search),), hands)
         spreads = (base_config.foothold_spread,)
     else:
         radii = itertools.product(terms_grid["trunk_radius"], terms_grid["leg_radius"], terms_grid["leg_forward"],
-                                  terms_grid["foothold"])
+                                  terms_grid["foothold"], hands)
         spreads = terms_grid["foothold_spread"]
     best, table = None, []
     base = np.array([base_config.trunk_radius, base_config.leg_radius, base_config.trunk_bottom,
                      base_config.leg_bottom, base_config.leg_top])
-    for trunk_radius, leg_radius, leg_forward, foothold in radii:
+    for trunk_radius, leg_radius, leg_forward, foothold, hand in radii:
         samples = raster_samples(terrain, poses[fit], trunk_radius, leg_radius, base_config.leg_lateral_offset,
-                                 leg_forward, foothold)
-        for spread in ((None,) if foothold is None else spreads):
-            figures = confusion(thresholds(samples, tb, lb, lt, spread), truth[fit])
+                                 leg_forward, foothold, hand)
+        for spread, hand_bottom in itertools.product((None,) if foothold is None else spreads,
+                                                     (None,) if hand is None else hand_bottoms):
+            figures = confusion(thresholds(samples, tb, lb, lt, spread, hand_bottom), truth[fit])
             sens, spec = figures["sensitivity"], figures["specificity"]
             youden = sens + spec - 1
             sensitive = sens >= TARGET_SENSITIVITY
@@ -408,7 +432,7 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
             params = np.column_stack([np.full(len(tb), trunk_radius), np.full(len(tb), leg_radius), tb, lb, lt])
             # tie-break: closest to the old defaults, and an optional term counts as 0.1 m away
             distance = (np.abs(params - base).sum(axis=1) + abs(leg_forward - base_config.leg_forward)
-                        + 0.1 * (spread is not None))
+                        + 0.1 * (spread is not None) + 0.1 * (hand is not None))
             # Rank: both targets met (then the best Youden index); else the sensitivity
             # target met (then the best specificity: a false negative ends episodes the
             # generator could have walked, for good, while a false positive is caught by
@@ -420,7 +444,9 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
                    "leg_bottom": float(lb[k]), "leg_top": float(lt[k]), "leg_forward": float(leg_forward),
                    "foothold_radius": None if spread is None else float(foothold[0]),
                    "foothold_search": None if spread is None else float(foothold[1]),
-                   "foothold_spread": None if spread is None else float(spread), "met": bool(met[k]),
+                   "foothold_spread": None if spread is None else float(spread),
+                   "hand_radius": None if hand is None else float(hand),
+                   "hand_bottom": None if hand is None else float(hand_bottom), "met": bool(met[k]),
                    "sensitive": bool(sensitive[k]), "score": float(score[k]),
                    "sensitivity": float(sens[k]), "specificity": float(spec[k]), "youden": float(youden[k]),
                    "distance": float(distance[k])}
@@ -430,9 +456,11 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
                 best = (rank, row)
     row = best[1]
     fields = {k: row[k] for k in ("trunk_radius", "leg_radius", "trunk_bottom", "leg_bottom", "leg_top",
-                                  "leg_forward", "foothold_spread")}
+                                  "leg_forward", "foothold_spread", "hand_radius")}
     if row["foothold_spread"] is not None:
         fields.update(foothold_radius=row["foothold_radius"], foothold_search=row["foothold_search"])
+    if row["hand_radius"] is not None:
+        fields.update(hand_bottom=row["hand_bottom"])
     config = dataclasses.replace(base_config, **fields)
     return {"config": config, "met": row["met"], "sensitive": row["sensitive"], "candidates": int(len(tb)) * len(table),
             "fit_figures": {"sensitivity": row["sensitivity"], "specificity": row["specificity"]},
@@ -472,6 +500,8 @@ def _describe(cfg) -> str:
     if cfg.foothold_spread is not None:
         text += (f", foothold r {cfg.foothold_radius:.3f} within {cfg.foothold_search:.2f} m, "
                  f"spread <= {cfg.foothold_spread:.3f} m")
+    if cfg.hand_radius is not None:
+        text += f", hands r {cfg.hand_radius:.2f} below {cfg.hand_bottom:+.2f}"
     return text
 
 
@@ -523,19 +553,30 @@ def main(argv=None) -> None:
     terms_search = grid_search(terrain, poses, truth, fit, old, terms_grid=TERMS_GRID)
     terms_seconds = time.perf_counter() - start
     with_terms = terms_search["config"]
+    start = time.perf_counter()
+    hands_grid = {"trunk_radius": (with_terms.trunk_radius,), "leg_radius": (with_terms.leg_radius,),
+                  "leg_forward": (with_terms.leg_forward,),
+                  "foothold": (None if with_terms.foothold_spread is None else
+                               (with_terms.foothold_radius, with_terms.foothold_search),),
+                  "foothold_spread": (with_terms.foothold_spread,), **HANDS_GRID}
+    hands_search = grid_search(terrain, poses, truth, fit, old, terms_grid=hands_grid)
+    hands_seconds = time.perf_counter() - start
+    with_hands = hands_search["config"]
     old_figures, old_pred = figures(terrain, poses, truth, old, fit)
     new_figures, new_pred = figures(terrain, poses, truth, new, fit)
     terms_figures, terms_pred = figures(terrain, poses, truth, with_terms, fit)
+    hands_figures, hands_pred = figures(terrain, poses, truth, with_hands, fit)
     current = ReachabilityConfig()
     current_figures, current_pred = figures(terrain, poses, truth, current, fit)
     # The NumPy thresholds of the searches must agree with the jitted condition.
     mismatch = 0
-    for cfg, pred in ((new, new_pred), (with_terms, terms_pred)):
+    for cfg, pred in ((new, new_pred), (with_terms, terms_pred), (with_hands, hands_pred)):
         foothold = None if cfg.foothold_spread is None else (cfg.foothold_radius, cfg.foothold_search)
         samples = raster_samples(terrain, poses, cfg.trunk_radius, cfg.leg_radius, cfg.leg_lateral_offset,
-                                 cfg.leg_forward, foothold)
+                                 cfg.leg_forward, foothold, cfg.hand_radius)
         mismatch += int(np.sum(thresholds(samples, cfg.trunk_bottom, cfg.leg_bottom, cfg.leg_top,
-                                          cfg.foothold_spread) != pred))
+                                          cfg.foothold_spread,
+                                          None if cfg.hand_radius is None else cfg.hand_bottom) != pred))
 
     print(f"\ngrid search: {search['candidates']} candidates in {search_seconds:.1f} s; best per radius pair "
           f"(fitting poses):")
@@ -556,14 +597,26 @@ def main(argv=None) -> None:
         print(f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
               f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {row['leg_forward']:5.2f} {foot:>24s} "
               f"{100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
+    print(f"\nsearch with the hands term on that setting: {hands_search['candidates']} candidates in "
+          f"{hands_seconds:.1f} s; best per hand radius and bottom (fitting poses):")
+    print(f"{'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} {'hand r':>6s} {'hand bot':>8s} "
+          f"{'sens %':>6s} {'spec %':>6s} {'met':>4s}")
+    for row in hands_search["table"]:
+        hand = ("   off", "     -") if row["hand_radius"] is None else (f"{row['hand_radius']:6.2f}",
+                                                                        f"{row['hand_bottom']:8.2f}")
+        print(f"{row['trunk_bottom']:9.3f} {row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {hand[0]:>6s} "
+              f"{hand[1]:>8s} {100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} "
+              f"{'yes' if row['met'] else 'no':>4s}")
     print()
     for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new (cylinders only)", new, new_figures),
                            ("new with the optional terms", with_terms, terms_figures),
+                           ("new with the optional terms and the hands", with_hands, hands_figures),
                            ("current EnvConfig defaults", current, current_figures)):
         print(f"{name}: {_describe(cfg)}")
         for part in ("all", "fit", "held_out"):
             print(f"  {part:9s} {_fmt(fig[part])}")
-    for name, result in (("cylinders only", search), ("with the optional terms", terms_search)):
+    for name, result in (("cylinders only", search), ("with the optional terms", terms_search),
+                         ("with the optional terms and the hands", hands_search)):
         print(f"{name}: targets (sens >= {100 * TARGET_SENSITIVITY:.0f} %, spec >= {100 * TARGET_SPECIFICITY:.0f} %) "
               f"{'met' if result['met'] else 'NOT met'} on the fitting poses (sensitivity target "
               f"{'met' if result['sensitive'] else 'NOT met'})")
@@ -575,24 +628,31 @@ def main(argv=None) -> None:
         else args.terrain,
         "poses": len(poses), "feasible": int(truth.sum()), "seed": args.seed, "workers": args.workers,
         "ground_truth_seconds": gt_seconds, "search_seconds": search_seconds, "terms_search_seconds": terms_seconds,
+        "hands_search_seconds": hands_seconds,
         "sampling": {"z_offsets_m": Z_OFFSETS, "near_obstacle_fraction": NEAR_FRACTION,
                      "reference": f"highest terrain point within {REFERENCE_RADIUS} m", "nominal_m": 1.0},
         "targets": {"sensitivity": TARGET_SENSITIVITY, "specificity": TARGET_SPECIFICITY},
         "flat_ground_constraint": {"heights_m": FLAT_HEIGHTS, "margin_m": FLAT_MARGIN},
         "grid": {k: list(map(float, v)) for k, v in GRID.items()}, "candidates": search["candidates"],
         "terms_grid": {k: list(v) for k, v in TERMS_GRID.items()}, "terms_candidates": terms_search["candidates"],
+        "hands_grid": {k: list(v) for k, v in HANDS_GRID.items()}, "hands_candidates": hands_search["candidates"],
         "targets_met_on_fit": search["met"], "sensitivity_target_met_on_fit": search["sensitive"],
         "terms_targets_met_on_fit": terms_search["met"],
         "terms_sensitivity_target_met_on_fit": terms_search["sensitive"],
-        "chosen": as_dict(new), "chosen_with_terms": as_dict(with_terms), "old": as_dict(old),
+        "hands_targets_met_on_fit": hands_search["met"],
+        "hands_sensitivity_target_met_on_fit": hands_search["sensitive"],
+        "chosen": as_dict(new), "chosen_with_terms": as_dict(with_terms), "chosen_with_hands": as_dict(with_hands),
+        "old": as_dict(old),
         "current": as_dict(current),
         "figures": {"old": old_figures, "new": new_figures, "new_with_terms": terms_figures,
-                    "current": current_figures},
+                    "new_with_hands": hands_figures, "current": current_figures},
         "by_height_offset": {"old": breakdown(poses, truth, old_pred, terrain),
                              "new": breakdown(poses, truth, new_pred, terrain),
                              "new_with_terms": breakdown(poses, truth, terms_pred, terrain),
+                             "new_with_hands": breakdown(poses, truth, hands_pred, terrain),
                              "current": breakdown(poses, truth, current_pred, terrain)},
         "best_per_radius_pair": search["table"], "best_per_terms_setting": terms_search["table"],
+        "best_per_hands_setting": hands_search["table"],
         "jit_numpy_mismatches": mismatch,
     })
 

@@ -154,3 +154,31 @@ def test_walking_truth_rejects_crouched_roots_the_static_truth_accepts():
     guide = rc.walking_guide(POSES[0])
     assert guide.shape == (rc.WALK_POSES, 4)
     np.testing.assert_allclose(np.hypot(*(guide[-1, :2] - guide[0, :2])), 0.36, atol=1e-9)
+
+
+def test_hands_term_catches_grippers_beside_the_wall():
+    """Roots 0.35 m from the wall's face, heading along it: the trunk cylinder (0.30 m) is
+    clear, but a half-sitting gripper (0.55 m sideways) is in the wall, so the generator
+    cannot stand there. The hands term rejects them; its NumPy form in the search agrees
+    with the jitted condition, and a search over the hands grid turns the term on."""
+    rng = np.random.default_rng(4)
+    side = np.column_stack([np.full(6, 4.3 - 0.35), rng.uniform(2.0, 4.0, 6), np.full(6, 1.0),
+                            rng.choice([-math.pi / 2, math.pi / 2], 6)])
+    poses = np.concatenate([POSES[:16], side])
+    truth = rc.ground_truth(TERRAIN, poses, workers=1)
+    assert truth[:16].all() and not truth[16:].any()
+    base = ReachabilityConfig()
+    assert rc.condition(TERRAIN, poses, base).all()  # every pose passes without the hands
+    hands = dataclasses.replace(base, hand_radius=0.13)
+    predicted = rc.condition(TERRAIN, poses, hands)
+    np.testing.assert_array_equal(predicted, truth)
+    samples = rc.raster_samples(TERRAIN, poses, base.trunk_radius, base.leg_radius, base.leg_lateral_offset,
+                                hand_radius=0.13)
+    np.testing.assert_array_equal(rc.thresholds(samples, base.trunk_bottom, base.leg_bottom, base.leg_top,
+                                                hand_bottom=hands.hand_bottom), predicted)
+    grid = {"trunk_radius": (0.30,), "leg_radius": (0.05,), "trunk_bottom": (base.trunk_bottom,),
+            "leg_bottom": (base.leg_bottom,), "leg_top": (base.leg_top,)}
+    terms = {"trunk_radius": (0.30,), "leg_radius": (0.05,), "leg_forward": (0.0,), "foothold": (None,),
+             "foothold_spread": (0.02,), "hand": (None, 0.13), "hand_bottom": (-0.40,)}
+    result = rc.grid_search(TERRAIN, poses, truth, np.ones(len(poses), dtype=bool), base, grid, terms)
+    assert result["met"] and result["config"].hand_radius == 0.13 and result["config"].hand_bottom == -0.40

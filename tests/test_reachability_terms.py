@@ -1,6 +1,7 @@
 """Hand-made cases for the optional terms of the reachability condition (issue 3 item 6):
-the lookahead leg cylinders (`leg_forward`) and the foothold flatness term
-(`foothold_radius`, `foothold_search`, `foothold_spread`). Both are off by default.
+the lookahead leg cylinders (`leg_forward`), the foothold flatness term
+(`foothold_radius`, `foothold_search`, `foothold_spread`) and the hands term
+(`hand_radius`, `hand_forward`, `hand_lateral`, `hand_bottom`). All are off by default.
 
 Terrains are 4 x 4 m rasters (2 cm cells, void at -2 m, world origin at the raster's
 corner); roots stand 1.0 m above the ground, where the default condition holds.
@@ -221,3 +222,51 @@ def test_default_spawn_points_are_valid_for_every_yaw():
     poses = np.column_stack([xy, np.ones(len(xy)), np.tile(yaws, len(spawn))]).astype(np.float32)
     ok = np.asarray(jax.jit(jax.vmap(lambda p: reachability.valid(field, p, reach)))(poses))
     assert ok.all(), poses[~ok][:5]
+
+
+@pytest.fixture(scope="module")
+def wall_terrain():
+    """Flat ground at 0 with a wall 1.0 m tall for y >= 2.5 m (its face along x)."""
+    heights = np.zeros((SIZE, SIZE), np.float32)
+    heights[:, cell(2.5):] = 1.0
+    return heights
+
+
+def test_hands_term_rejects_a_wall_beside_the_grippers_only(wall_terrain):
+    """Root 1.0 m up, heading +x: the left hand disk (centre 0.45 m to the left, radius
+    0.13 m) reaches y + 0.58. The trunk (0.30 m) alone accepts the root 0.35 m from the
+    wall; the hands term rejects it there, accepts it 0.65 m away, and turning the root
+    to face the wall (hands along the face, 0.12 m ahead) accepts it at 0.35 m again."""
+    reach = ReachabilityConfig(hand_radius=0.13)
+    assert ReachabilityConfig().hand_radius is None
+    field = field_of(wall_terrain, reach)
+    assert field.hand_max.shape == field.heights.shape
+    near, far = pose(2.0, 2.15), pose(2.0, 1.85)
+    assert valid(field, near, ReachabilityConfig())  # the default condition has no hands
+    t = reachability.terms(field, near, reach)
+    assert not bool(t["left_hand_free"]) and bool(t["right_hand_free"]) and bool(t["trunk_free"])
+    assert not valid(field, near, reach)
+    assert valid(field, far, reach)
+    assert valid(field, pose(2.0, 2.15, yaw=math.pi / 2), reach)  # 0.35 - 0.12 - 0.13 = 0.10 m to spare
+    # Lower hands pass over a lower wall: 1.0 m - 0.40 m = 0.60 m is the highest terrain they clear.
+    low = field_of(np.where(wall_terrain > 0, 0.55, 0.0).astype(np.float32), reach)
+    assert valid(low, near, reach)
+
+
+def test_hands_term_needs_its_raster(wall_terrain):
+    field = field_of(wall_terrain, ReachabilityConfig())
+    with pytest.raises(ValueError, match="hand raster"):
+        reachability.terms(field, pose(2.0, 1.0), ReachabilityConfig(hand_radius=0.13))
+
+
+def test_hands_term_spawn_points_keep_every_yaw_clear(wall_terrain):
+    reach = ReachabilityConfig(hand_radius=0.13)
+    field = field_of(wall_terrain, reach, require_spawn=True)
+    spawn = np.asarray(field.spawn_xy)
+    below = spawn[spawn[:, 1] < 2.5]  # the wall's top, 1.5 m wide, is ground too
+    assert len(below) and below[:, 1].max() <= 2.5 - (math.hypot(0.12, 0.45) + 0.13) + 1e-6
+    z = wall_terrain[np.round(spawn[:, 0] / RES).astype(int), np.round(spawn[:, 1] / RES).astype(int)] + 1.0
+    for yaw in np.linspace(0.0, 2 * math.pi, 9):
+        batch = jnp.column_stack([jnp.asarray(spawn), jnp.asarray(z), jnp.full(len(spawn), yaw)])
+        ok = jax.vmap(lambda p: reachability.valid(field, p, reach))(batch)
+        assert bool(ok.all())

@@ -61,6 +61,17 @@ class ReachabilityConfig:
     # m, foothold: each leg needs, within foothold_search of its centre, a sole disk of radius
     # foothold_radius over solid terrain (no void) whose heights span at most this. None disables it.
     foothold_spread: float | None = None
+    # Hands: the Talos model keeps its arms at the half-sitting posture, where the grippers
+    # reach 0.55 m sideways from the root, 0.04-0.21 m ahead of it and down to 0.39 m below it
+    # (measured on the model's collision geometry), outside the trunk cylinder: guides
+    # 0.3-0.55 m from a wall or pillar pass the trunk term and the generator stops there with a
+    # gripper in the obstacle. Each hand disk, of radius hand_radius centred at
+    # (hand_forward, ±hand_lateral) in the root frame, must hold no terrain above
+    # z + hand_bottom. None disables the term.
+    hand_radius: float | None = None
+    hand_forward: float = 0.12  # m, hand disk centres ahead of the root (the grippers span 0.04-0.21 m)
+    hand_lateral: float = 0.45  # m, hand disk centres beside the root (the grippers span 0.35-0.55 m)
+    hand_bottom: float = -0.40  # m below the root: the grippers' lowest point is 0.39 m below it
 
 
 @dataclass(frozen=True)

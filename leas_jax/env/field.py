@@ -34,6 +34,8 @@ class Heightfield:
         foothold: [nx, ny] smallest height spread of a sole disk of radius `foothold_radius`
             centred within `foothold_search` of the point (+inf where every such disk touches
             the void); [1, 1] zeros when the foothold term is disabled (`foothold_spread` None).
+        hand_max: [nx, ny] highest terrain point within `hand_radius` of the point; [1, 1]
+            zeros when the hands term is disabled (`hand_radius` None).
         origin: [2] world (x, y) of `heights[0, 0]`.
         resolution: [] cell size (m).
         void_height: [] height outside the grid.
@@ -47,6 +49,7 @@ class Heightfield:
     leg_max: jax.Array
     leg_min: jax.Array
     foothold: jax.Array
+    hand_max: jax.Array
     origin: jax.Array
     resolution: jax.Array
     void_height: jax.Array
@@ -187,7 +190,8 @@ def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float
         farthest + leg_radius + one cell, a disk that holds every leg disk whatever
         the yaw, is solid ground within the band.
     With the foothold term, the foothold raster must pass within `farthest` of the
-    point (every yaw). (Host, NumPy.)
+    point (every yaw). With the hands term, the terrain within the hand disks' reach
+    (centre distance + radius + one cell) stays below the hands. (Host, NumPy.)
     """
     reach = config.reachability
     stride = max(int(round(spacing / resolution)), 1)
@@ -207,6 +211,9 @@ def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float
         ok &= (lowest >= z + reach.leg_bottom) & (highest <= z + reach.leg_top)
     if foothold is not None:
         ok &= disk_filter(foothold, farthest / resolution, "max", np.inf) <= reach.foothold_spread
+    if reach.hand_radius is not None:
+        hands = (float(np.hypot(reach.hand_forward, reach.hand_lateral)) + reach.hand_radius + resolution) / resolution
+        ok &= disk_filter(heights, hands, "max", void_height) < z + reach.hand_bottom
     # keep away from the grid border so that jittered resets stay inside
     ok[:stride, :] = ok[-stride:, :] = False
     ok[:, :stride] = ok[:, -stride:] = False
@@ -241,6 +248,8 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
         foothold = None
     else:
         foothold = foothold_raster(heights, void_height, resolution, reach.foothold_radius, reach.foothold_search)
+    hand_max = None if reach.hand_radius is None else disk_filter(heights, reach.hand_radius / resolution, "max",
+                                                                   void_height)
     spawn_ij = _spawn_points(heights, trunk_max, void_height, resolution, config, spawn_spacing, foothold)
     if len(spawn_ij) == 0:
         if require_spawn:
@@ -251,6 +260,7 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
     return Heightfield(
         heights=f32(heights), trunk_max=f32(trunk_max), leg_max=f32(leg_max), leg_min=f32(leg_min),
         foothold=f32(np.zeros((1, 1)) if foothold is None else foothold),
+        hand_max=f32(np.zeros((1, 1)) if hand_max is None else hand_max),
         origin=f32(origin), resolution=f32(resolution), void_height=f32(void_height),
         spawn_xy=f32(spawn_xy), spawn_spacing=f32(spawn_spacing),
     )

@@ -14,7 +14,7 @@ A pose is valid when
     a vertical jump taller than the band (leg_top - leg_bottom) skips it
     entirely, e.g. a leg disk straddling a tall wall; the trunk test rejects
     most such poses.
-Two optional terms (disabled by the defaults of `ReachabilityConfig`; see
+Three optional terms (disabled by the defaults of `ReachabilityConfig`; see
 benchmarks/reachability_false_positives.py for the false positives they target):
   - lookahead (`leg_forward` != 0): a second pair of leg cylinders centred at
     (leg_forward, ±leg_lateral_offset) in the root frame, same radius and band,
@@ -23,6 +23,10 @@ benchmarks/reachability_false_positives.py for the false positives they target):
     `foothold_search` of its centre, a sole disk of radius `foothold_radius` over
     solid terrain whose heights span at most `foothold_spread` (one raster,
     `Heightfield.foothold`).
+  - hands (`hand_radius` not None): a disk of radius `hand_radius` centred at
+    (hand_forward, ±hand_lateral) in the root frame around each gripper of the
+    half-sitting arms holds no terrain above z + hand_bottom (one raster,
+    `Heightfield.hand_max`).
 Disk maxima and minima are precomputed rasters (`Heightfield`), so the test
 costs three gathers per leg pair (and one more per leg for the foothold).
 """
@@ -52,6 +56,12 @@ def all_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityCo
     return pose[:2] + rotate_z(offsets, pose[3])
 
 
+def hand_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
+    """World (x, y) of the hand disks, [2, 2] (left, right). pose: [4] (x, y, z, yaw), world."""
+    offsets = jnp.array([[config.hand_forward, config.hand_lateral], [config.hand_forward, -config.hand_lateral]])
+    return pose[:2] + rotate_z(offsets, pose[3])
+
+
 def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> dict:
     """The parts of the condition.
 
@@ -63,7 +73,8 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
     Returns:
         dict of bool[]: trunk_free, left_touch, right_touch, left_ahead_touch,
         right_ahead_touch (the lookahead legs; True when disabled), left_foothold,
-        right_foothold (over the legs and lookahead legs of each side; True when disabled).
+        right_foothold (over the legs and lookahead legs of each side; True when disabled),
+        left_hand_free, right_hand_free (True when disabled).
     """
     z = pose[2]
     trunk_free = sample_nearest(field, field.trunk_max, pose[:2]) < z + config.trunk_bottom
@@ -82,9 +93,18 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
         flat = sample_nearest(field, field.foothold, legs, outside=jnp.inf) <= config.foothold_spread
         flat = flat.reshape(-1, 2).all(axis=0)  # [2]: left, right (over the leg and its lookahead leg)
         foothold = (flat[0], flat[1])
+    if config.hand_radius is None:
+        hands = (yes, yes)
+    else:
+        if field.hand_max.shape != field.heights.shape:
+            raise ValueError("the hands term is enabled but the heightfield has no hand raster: "
+                             "build it with the same ReachabilityConfig")
+        free = sample_nearest(field, field.hand_max, hand_centers(pose, config), outside=-jnp.inf) < z + config.hand_bottom
+        hands = (free[0], free[1])
     return {"trunk_free": trunk_free, "left_touch": touch[0], "right_touch": touch[1],
             "left_ahead_touch": ahead[0], "right_ahead_touch": ahead[1],
-            "left_foothold": foothold[0], "right_foothold": foothold[1]}
+            "left_foothold": foothold[0], "right_foothold": foothold[1],
+            "left_hand_free": hands[0], "right_hand_free": hands[1]}
 
 
 def valid(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:

@@ -20,17 +20,16 @@ class ReachabilityConfig:
     the contact generator *walking* (`--truth walking`: a pose is feasible when the
     generator covers a 0.36 m straight guide from it; 12 000 poses of
     terrains/training_arena.toml). The static truth (one double-support posture, the
-    issue's definition) let the root down to 0.525 m, where the generator does not walk.
+    issue's definition) lets the root down to about 0.5 m, where the generator does not walk.
 
-    Against the current generator, which walks with the root 0.80-1.15 m above flat
-    ground (benchmarks/walking_height.py), these defaults give sensitivity 81.2 %,
-    specificity 84.9 %; the feasible poses they reject are crouched ones. The best
-    setting at >= 95 % sensitivity gives 94.6 / 80.1 % (94.9 / 83.7 % with the optional
-    lookahead and foothold terms below). No setting reaches 90 % specificity at 95 %
-    sensitivity. The defaults are kept: a false positive is a guide the generator cannot
-    follow, a false negative only keeps the policy higher than it needs to be, and the
-    shipped policy was trained with them. The README's "Contact generator" section has
-    the history of these figures.
+    Against the current generator (880454d: a sole may rest across coplanar boxes), these
+    defaults give sensitivity 79.7 %, specificity 89.0 %. The best cylinders at >= 95 %
+    sensitivity give 95.0 / 85.3 %; with the optional lookahead, foothold and hands terms
+    below, 94.7 / 90.2 % (95.0 / 89.9 % on the fitting poses). The defaults are kept: a
+    quick policy trained with that stricter setting kept only 76 % of arena episodes free
+    of the poses it rejects (89 % with these), the shipped policy was trained with these,
+    and a false negative only keeps the policy higher than it needs to be. The README's
+    "Contact generator" section has the figures and their history.
     """
 
     # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)

@@ -283,3 +283,20 @@ def test_start_on_rubble_tries_other_soles():
     plan = plan_contacts(arena, pose[None], DT)
     assert plan.last_valid_index == 0 and len(plan.q) == 1
     assert verify(plan).ok
+
+
+def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
+    """The first 30 s of a shipped-policy guide on eval_circuit's slabs (its root 1.05 m above
+    the stance sole, which a slab's edge put 4 cm from the guide's line instead of 8.5 cm):
+    held under its hip, the lifted foot met the stance shin at every root shift and the
+    plan stopped at pose 160; held `swing_clearance` farther out, it passes."""
+    from leas_jax.eval.scenarios import scenario_file
+    from leas_jax.terrain import load_terrain
+
+    data = np.load(Path(__file__).parent / "data" / "eval_circuit_slabs_leas_guide.npz")
+    circuit = load_terrain(scenario_file("circuit"))
+    plan = plan_contacts(circuit, data["guide"], float(data["timestep"]))
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    held_under = plan_contacts(circuit, data["guide"], float(data["timestep"]), GeneratorConfig(swing_clearance=0.0))
+    assert held_under.last_valid_index == 160

@@ -94,6 +94,7 @@ class GeneratorConfig:
     cover_tol: float = 0.005  # m, a sole is covered if the terrain rises more than this above it (DESIGN §6: 5 mm)
     feet_gap: float = 0.01  # m, minimal gap between the two sole rectangles (see edge_margin)
     swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
+    swing_clearance: float = 0.05  # m, how far out of its hip a lifted foot may be held (see `_step`)
     # m: where single support with the CoM over the stance sole's centre fails, the CoM is
     # aimed instead at the point of that sole, this far inside its edges, nearest the guide
     # root (a shorter root shift; eval_circuit's pillars). 3 cm leaves twice flat_com_margin. None: off.
@@ -202,8 +203,10 @@ class ContactGenerator:
             guide_pose: [4] (x, y, z, yaw) guide root pose, world.
             guide_index: its guide index.
             contacts: list of (side, pos, rot) soles in contact, world.
-            air: None, or (side, list of (pos, rot) world placements to try for the foot
-                in the air, in order).
+            air: None, or (side, list of (pos, rot, follows_root) placements to try for
+                the foot in the air, in order: at each root offset, the first with which
+                every check passes). pos [3], rot [3, 3] world; with follows_root, pos
+                moves with the root's horizontal shift (a foot held under its hip).
             com_target: [2] where the root shift should bring the CoM (x, y), or None to
                 try the guide root first and shift toward the support centre only if needed.
 
@@ -217,14 +220,18 @@ class ContactGenerator:
         support_centre = np.mean([pos[:2] for _, pos, _ in contacts], axis=0)
         target = support_centre if com_target is None else np.asarray(com_target)
         offsets = [None] if com_target is not None else [np.zeros(2), None]
+        airs = [None] if air is None else [(air[0], *option) for option in air[1]]
         for offset in offsets:
-            built = self._build(guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air)
-            if built is not None:
-                return built
+            for one_air in airs:
+                built = self._build(guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, one_air)
+                if built is not None:
+                    return built
         return None
 
     def _build(self, guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air):
-        """One root offset (None: shift the CoM onto `target`); all checks. Returns a posture or None."""
+        """One root offset (None: shift the CoM onto `target`) and one placement of the foot in
+        the air (None, or (side, pos [3], rot [3, 3], follows_root), see `_posture`); all checks.
+        Returns a posture or None."""
         cfg = self.config
         talos = self.talos
         iterations = 1 if offset is not None else 3
@@ -242,14 +249,13 @@ class ContactGenerator:
             if leg_q is None:
                 return None
             if air is not None:
-                side, options = air
-                for pos, rot in options:
-                    solved = self._legs_ik(root_R, root_p, [(side, pos, rot)])
-                    if solved is not None:
-                        leg_q[side] = solved[side]
-                        break
-                else:
+                side, pos, rot, follows_root = air
+                if follows_root:
+                    pos = pos + np.array([shift[0], shift[1], 0.0])
+                solved = self._legs_ik(root_R, root_p, [(side, pos, rot)])
+                if solved is None:
                     return None
+                leg_q[side] = solved[side]
             q = talos.configuration(root_p, root_R, leg_q)
             com = talos.com(q)
             if offset is None and it + 1 < iterations:
@@ -538,14 +544,19 @@ class ContactGenerator:
         other = 1 - side
         stance = (other, feet[other][0], feet[other][1])
         old_pos, old_rot = feet[side]
-        lifted = [(old_pos + np.array([0.0, 0.0, cfg.swing_lift]), old_rot)]
+        lifted = [(old_pos + np.array([0.0, 0.0, cfg.swing_lift]), old_rot, False)]
         # Or under its hip, swing_lift above its last contact (or above the half-sitting sole
         # height where that is higher, as on a step up). The half-sitting height alone put the
         # foot 12 cm underground under a root 0.85 m above the ground, where crouched walking
         # fails otherwise (the trailing foot cannot stay flat: ankle pitch < -1.31 rad).
         nominal_pos, _ = self._nominal_placement(pose, side)
         nominal_pos[2] = max(nominal_pos[2], old_pos[2]) + cfg.swing_lift
-        lifted.append((nominal_pos, _rotz(pose[3])))
+        # Held under the hip, it follows the root's shift toward the stance sole; or, where
+        # that stance sole is nearer the guide's line than its nominal place (the other leg
+        # then meets this one), swing_clearance farther out.
+        lifted.append((nominal_pos, _rotz(pose[3]), True))
+        outward = _rotz(pose[3])[:, 1] * (1.0 if side == LEFT else -1.0)
+        lifted.append((nominal_pos + cfg.swing_clearance * outward, _rotz(pose[3]), True))
         single = self._posture(pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2])
         if single is None and cfg.single_support_com_inset is not None:
             # The root shift that brings the CoM over the sole's centre can put the body into

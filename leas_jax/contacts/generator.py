@@ -551,10 +551,10 @@ class ContactGenerator:
         # fails otherwise (the trailing foot cannot stay flat: ankle pitch < -1.31 rad).
         nominal_pos, _ = self._nominal_placement(pose, side)
         nominal_pos[2] = max(nominal_pos[2], old_pos[2]) + cfg.swing_lift
-        # Held under the hip, it follows the root's shift toward the stance sole; or, where
-        # that stance sole is nearer the guide's line than its nominal place (the other leg
-        # then meets this one), swing_clearance farther out.
-        lifted.append((nominal_pos, _rotz(pose[3]), True))
+        lifted.append((nominal_pos, _rotz(pose[3]), False))
+        # Or swing_clearance farther out, following the root's shift toward the stance sole:
+        # where that sole is nearer the guide's line than its nominal place, the stance
+        # shin meets a foot held under its hip.
         outward = _rotz(pose[3])[:, 1] * (1.0 if side == LEFT else -1.0)
         lifted.append((nominal_pos + cfg.swing_clearance * outward, _rotz(pose[3]), True))
         single = self._posture(pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2])

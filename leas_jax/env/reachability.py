@@ -62,6 +62,14 @@ def hand_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfi
     return pose[:2] + rotate_z(offsets, pose[3])
 
 
+def _term_raster(field: Heightfield, raster: jax.Array, term: str) -> jax.Array:
+    """The raster of an enabled optional term; ValueError if the field was built without it."""
+    if raster.shape != field.heights.shape:
+        raise ValueError(f"the {term} term is enabled but the heightfield has no {term} raster: "
+                         "build it with the same ReachabilityConfig")
+    return raster
+
+
 def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> dict:
     """The parts of the condition.
 
@@ -87,19 +95,15 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
     if config.foothold_spread is None:
         foothold = (yes, yes)
     else:
-        if field.foothold.shape != field.heights.shape:
-            raise ValueError("the foothold term is enabled but the heightfield has no foothold raster: "
-                             "build it with the same ReachabilityConfig")
-        flat = sample_nearest(field, field.foothold, legs, outside=jnp.inf) <= config.foothold_spread
+        flat = sample_nearest(field, _term_raster(field, field.foothold, "foothold"), legs,
+                              outside=jnp.inf) <= config.foothold_spread
         flat = flat.reshape(-1, 2).all(axis=0)  # [2]: left, right (over the leg and its lookahead leg)
         foothold = (flat[0], flat[1])
     if config.hand_radius is None:
         hands = (yes, yes)
     else:
-        if field.hand_max.shape != field.heights.shape:
-            raise ValueError("the hands term is enabled but the heightfield has no hand raster: "
-                             "build it with the same ReachabilityConfig")
-        free = sample_nearest(field, field.hand_max, hand_centers(pose, config), outside=-jnp.inf) < z + config.hand_bottom
+        free = sample_nearest(field, _term_raster(field, field.hand_max, "hand"), hand_centers(pose, config),
+                              outside=-jnp.inf) < z + config.hand_bottom
         hands = (free[0], free[1])
     return {"trunk_free": trunk_free, "left_touch": touch[0], "right_touch": touch[1],
             "left_ahead_touch": ahead[0], "right_ahead_touch": ahead[1],

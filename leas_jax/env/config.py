@@ -22,11 +22,11 @@ class ReachabilityConfig:
     terrains/training_arena.toml). The static truth (one double-support posture, the
     issue's definition) lets the root down to about 0.5 m, where the generator does not walk.
 
-    Against the current generator (880454d: a sole may rest across coplanar boxes), these
-    defaults give sensitivity 79.7 %, specificity 89.0 %. The best cylinders at >= 95 %
-    sensitivity give 95.0 / 85.3 %; with the optional lookahead, foothold and hands terms
-    below, 94.7 / 90.2 % (95.0 / 89.9 % on the fitting poses). The defaults are kept: a
-    quick policy trained with that stricter setting kept only 76 % of arena episodes free
+    Against the current generator (939131f), these defaults give sensitivity 79.5 %,
+    specificity 89.2 %. The best cylinders at >= 95 % sensitivity give 94.9 / 85.6 %; with
+    the optional lookahead, foothold and hands terms below, 94.5 / 90.3 % (95.2 / 89.8 % on
+    the fitting poses). The defaults are kept: a quick policy trained with such a stricter
+    setting kept only 76 % of arena episodes free
     of the poses it rejects (89 % with these), the shipped policy was trained with these,
     and a false negative only keeps the policy higher than it needs to be. The README's
     "Contact generator" section has the figures and their history.

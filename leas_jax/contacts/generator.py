@@ -206,7 +206,7 @@ class ContactGenerator:
             air: None, or (side, list of (pos, rot, follows_root) placements to try for
                 the foot in the air, in order: at each root offset, the first with which
                 every check passes). pos [3], rot [3, 3] world; with follows_root, pos
-                moves with the root's horizontal shift (a foot held under its hip).
+                moves with the root's horizontal shift (the foot held `swing_clearance` out of its hip).
             com_target: [2] where the root shift should bring the CoM (x, y), or None to
                 try the guide root first and shift toward the support centre only if needed.
 

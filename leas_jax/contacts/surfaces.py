@@ -17,6 +17,7 @@ between two faces of one plane could go unseen (the terrains' gaps are >= 0.15 m
 
 from __future__ import annotations
 
+import functools
 import math
 import weakref
 from dataclasses import dataclass
@@ -123,15 +124,17 @@ def coplanar_groups(normals: np.ndarray, offsets: np.ndarray, bbox: np.ndarray) 
             a, b = root(i), root(int(j))
             if a != b:
                 parent[max(a, b)] = min(a, b)
+    # Each root is its component's smallest face index, so sorted roots number the
+    # groups in order of their first face.
     roots = np.array([root(i) for i in range(count)], dtype=np.int64)
-    _, first, ids = np.unique(roots, return_index=True, return_inverse=True)
-    order = np.argsort(np.argsort(first))  # renumber by first face
-    return order[ids].reshape(-1)
+    return np.unique(roots, return_inverse=True)[1].reshape(-1)
 
 
-def _sole_samples(grow: float) -> np.ndarray:
-    """[P, 3] points of the sole rectangle grown by `grow` (m) on every side, sole frame:
-    its edges every <= UNION_EDGE_STEP (corners included) and inside every <= UNION_INNER_STEP."""
+@functools.lru_cache(maxsize=8)
+def _sole_samples(grow: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points of the sole rectangle grown by `grow` (m) on every side, sole frame: its edges
+    every <= UNION_EDGE_STEP and inside every <= UNION_INNER_STEP, as (corners [4, 3],
+    the other points [P, 3])."""
     half = np.array([SOLE_LENGTH / 2 + grow, SOLE_WIDTH / 2 + grow])
     edge = [np.linspace(-h, h, int(math.ceil(2 * h / UNION_EDGE_STEP)) + 1) for h in half]
     inner = [np.linspace(-h, h, int(math.ceil(2 * h / UNION_INNER_STEP)) + 1)[1:-1] for h in half]
@@ -139,10 +142,17 @@ def _sole_samples(grow: float) -> np.ndarray:
                             + [np.stack([np.full_like(edge[1], sx * half[0]), edge[1]], axis=1) for sx in (-1, 1)])
     grid = np.stack(np.meshgrid(*inner, indexing="ij"), axis=-1).reshape(-1, 2)
     points = np.unique(np.round(np.concatenate([border, grid]), 12), axis=0)
-    return np.concatenate([points, np.zeros((len(points), 1))], axis=1)
+    points = np.concatenate([points, np.zeros((len(points), 1))], axis=1)
+    corner = np.all(np.isclose(np.abs(points[:, :2]), half), axis=1)
+    return points[corner], points[~corner]
 
 
-_SAMPLES: dict = {}
+def _inside_edges(points: np.ndarray, edges: tuple, margin: float) -> np.ndarray:
+    """[...] whether points [..., 3] on or near a face's plane are `margin` inside all its
+    edges (`SurfaceArrays.edges` of the face: the inward normals lie in the plane, so the
+    points need no projection)."""
+    inward, bounds = edges
+    return np.all(points @ inward.T >= bounds + margin, axis=-1)
 
 
 def sole_inside_union(surfaces: "SurfaceArrays", faces, pos, rot, margin: float) -> np.ndarray:
@@ -163,20 +173,15 @@ def sole_inside_union(surfaces: "SurfaceArrays", faces, pos, rot, margin: float)
     """
     pos = np.asarray(pos, dtype=np.float64).reshape(-1, 3)
     rot = np.broadcast_to(np.asarray(rot, dtype=np.float64), (len(pos), 3, 3))
-    if margin not in _SAMPLES:
-        _SAMPLES[margin] = _sole_samples(margin)
-    samples = _SAMPLES[margin]
-    corners = np.abs(np.abs(samples[:, :2]) - np.abs(samples[:, :2]).max(axis=0)).max(axis=1) < 1e-12
     ok = np.ones(len(pos), dtype=bool)
-    for subset in (samples[corners], samples[~corners]):
+    for subset in _sole_samples(margin):
         idx = np.flatnonzero(ok)
         if len(idx) == 0:
             break
         points = (pos[idx, None, :] + np.einsum("nij,pj->npi", rot[idx], subset)).reshape(-1, 3)  # [n P, 3]
         covered = np.zeros(len(points), dtype=bool)
         for s in faces:
-            inward, bounds = surfaces.edges[s]
-            covered |= np.all(points @ inward.T >= bounds - _INSIDE_TOL, axis=1)
+            covered |= _inside_edges(points, surfaces.edges[s], -_INSIDE_TOL)
         ok[idx] = covered.reshape(len(idx), -1).all(axis=1)
     return ok
 
@@ -227,29 +232,20 @@ def sole_corners_world(pos, rot) -> np.ndarray:
 def inside_polygon(surface, points, margin: float = 0.0) -> np.ndarray:
     """Whether points on a face's plane lie inside its polygon, `margin` m from the edges.
 
-    The polygon is counter-clockwise seen from the normal's tip, so a point p is
-    inside iff ((v_{k+1} - v_k) x (p - v_k)) . n >= 0 for every edge k; dividing by the
-    edge length gives the signed distance to the edge line.
+    The polygon is counter-clockwise seen from the normal's tip, so edge k's inward
+    normal in the plane is n x (v_{k+1} - v_k), normalised; the signed distance of p
+    to the edge line is inward_k . (p - v_k) (`_edge_normals`, `_inside_edges`).
 
     Args:
         surface: a SupportSurface.
-        points: [..., 3] world points (projected on the plane along the normal first).
+        points: [..., 3] world points on or near the face's plane (their offset along
+            the normal does not change the test).
         margin: required distance from every edge, m (negative: tolerance outside).
 
     Returns:
         [...] bool.
     """
-    verts = surface.vertices
-    normal = surface.normal
-    pts = np.asarray(points, dtype=np.float64)
-    pts = pts - ((pts - verts[0]) @ normal)[..., None] * normal
-    ok = np.ones(pts.shape[:-1], dtype=bool)
-    for k in range(len(verts)):
-        edge = verts[(k + 1) % len(verts)] - verts[k]
-        inward = np.cross(normal, edge)
-        inward /= np.linalg.norm(inward)
-        ok &= (pts - verts[k]) @ inward >= margin
-    return ok
+    return _inside_edges(np.asarray(points, dtype=np.float64), _edge_normals(surface), margin)
 
 
 _BOUNDS_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

@@ -25,10 +25,9 @@ class ReachabilityConfig:
     Against the current generator (939131f), these defaults give sensitivity 79.5 %,
     specificity 89.2 %. The best cylinders at >= 95 % sensitivity give 94.9 / 85.6 %; with
     the optional lookahead, foothold and hands terms below, 94.5 / 90.3 % (95.2 / 89.8 % on
-    the fitting poses). The defaults are kept: a quick policy trained with such a stricter
-    setting kept only 76 % of arena episodes free
-    of the poses it rejects (89 % with these), the shipped policy was trained with these,
-    and a false negative only keeps the policy higher than it needs to be. The README's
+    the fitting poses). The defaults are kept: the stricter setting ends more training
+    episodes, the shipped policy was trained with these, and a false negative only keeps
+    the policy higher than it needs to be. The README's
     "Contact generator" section has the figures and their history.
     """
 

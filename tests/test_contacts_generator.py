@@ -128,6 +128,24 @@ def test_narrow_bridge_crossed_on_its_centre_line():
     assert verify(plan).ok
 
 
+def test_bridge_crossed_by_a_guide_off_its_centre_line():
+    """A guide 4 cm right of the 0.30 m bridge's centre line (LeaS guides run that far off it):
+    the step targets move into the foot's lane of the beam, so both soles stay centred and
+    the root's balancing shift absorbs the offset. At nominal places, the left sole took the
+    centre line and the right one found no room beside it: the plan stopped at the bridge."""
+    bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+                           + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    guide = straight(0.0, 5.0)
+    guide[:, 1] = -0.04
+    plan = plan_contacts(bridge, guide, DT)
+    assert plan.coverage == 1.0 and verify(plan).ok
+    feet = plan.feet[:, :, :2]
+    on_bridge = np.isfinite(feet[..., 0]) & (feet[..., 0] > 2.1) & (feet[..., 0] < 3.9)
+    assert np.all(feet[:, 0, 1][on_bridge[:, 0]] > 0.0) and np.all(feet[:, 1, 1][on_bridge[:, 1]] < 0.0)
+    without_lanes = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0))
+    assert without_lanes.coverage < 1.0 and x_at(without_lanes, without_lanes.last_valid_index) < 2.2
+
+
 def test_hole_stops_before_it():
     hole = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([5, 0, -0.1], [4, 4, 0.2]))
     plan = plan_contacts(hole, straight(0.0, 4.0), DT)

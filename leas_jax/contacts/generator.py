@@ -43,7 +43,7 @@ from leas_jax.contacts.ik import leg_ik, leg_ik_single
 from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
                                      load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
-from leas_jax.contacts.surfaces import (SOLE_CORNERS, sole_corners_world, sole_inside_union, sole_rotation,
+from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corners_world, sole_inside_union, sole_rotation,
                                         sole_rotation_single, surface_arrays, uncovered)
 from leas_jax.errors import UsageError
 
@@ -83,9 +83,10 @@ class GeneratorConfig:
     # the guide's yaw at the same place. eval_bridge's 0.30 m beam leaves 2 cm beside two
     # soles side by side; at 11 degrees off its axis they need 5 cm more, and LeaS guides
     # wander that much (bridge success 8 -> 10 of 60 guides of the shipped policy). Beams
-    # only: aligning soles to every face's edges cost 5 of 60 eval_stairs guides.
+    # only: aligning soles to every face's edges cost 5 of 60 eval_stairs guides. Walking
+    # along such a beam, each foot's step target also moves into its lane (`_beam_lane`).
     beam_width: float = 0.5  # m; the arena's bridges are 0.30-0.45 m wide, its stair treads 0.30 m deep
-    beam_align_yaw: float = 0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables
+    beam_align_yaw: float = 0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables (lanes too)
     # m, sole rectangle kept this far inside the face polygon (DESIGN §6's 5 mm tolerance). Two
     # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin: with 1 cm and 2 cm that was
     # exactly the 0.30 m of eval_bridge, which no guide could cross: a centred straight guide at
@@ -157,7 +158,7 @@ class ContactGenerator:
                        for leg in legs]
         self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
         self._nominal_xy = [tuple(row[:2].tolist()) for row in self._nominal]
-        self._beam_axes = {}  # face index -> [A] yaws (rad) of the edges it is narrower than beam_width across
+        self._beams = {}  # face index -> [A, 3] beam edges (`_beam_edges`)
         # Diagnostics: postures built, candidates that passed the cover and reach tests
         # (those screened: `_step` screens its candidates lazily).
         self.stats = {"postures_tried": 0, "candidates": 0}
@@ -445,19 +446,60 @@ class ContactGenerator:
         keep[np.nonzero(free)[0][reachable]] = True
         return keep
 
+    def _beam_edges(self, s: int) -> np.ndarray:
+        """[A, 3] the edges face s is narrower than `beam_width` across: (axis yaw (rad), lo, hi),
+        lo and hi bounding the face (m, world) along the axis's left normal (-sin, cos)(yaw)."""
+        if s not in self._beams:
+            verts = self.surfaces.surfaces[s].vertices
+            rows = []
+            for edge in np.roll(verts, -1, axis=0) - verts:
+                axis = edge[:2] / max(math.hypot(edge[0], edge[1]), 1e-12)
+                across = verts[:, :2] @ np.array([-axis[1], axis[0]])
+                if np.ptp(across) < self.config.beam_width:
+                    rows.append((math.atan2(axis[1], axis[0]), across.min(), across.max()))
+            self._beams[s] = np.array(rows, dtype=np.float64).reshape(-1, 3)
+        return self._beams[s]
+
+    def _beam_lane(self, side: int, target_pos: np.ndarray, target_yaw: float) -> np.ndarray:
+        """A step target [3] (world) moved across a beam walked along into its side's lane.
+
+        On a beam (a face narrower than `beam_width`) whose axis is within `beam_align_yaw`
+        of the target yaw, the sole's centre is kept between SOLE_WIDTH / 2 + feet_gap / 2
+        from the beam's centre line (room for the other sole) and SOLE_WIDTH / 2 +
+        edge_margin from its edge, on the foot's side. A guide 4 cm off eval_bridge's 0.30 m
+        centre line put the left sole on its nominal place, 4 cm left of the line, where
+        the right one no longer fit beside it; with lanes, both feet stay centred and the
+        root's balancing shift absorbs the guide's offset. Faces too narrow for two soles,
+        and other faces, leave the target as it is.
+        """
+        if self.config.beam_align_yaw <= 0.0:
+            return target_pos
+        cfg, surfaces = self.config, self.surfaces
+        xy = np.asarray(target_pos[:2], dtype=np.float64)
+        inner = 0.5 * SOLE_WIDTH + 0.5 * cfg.feet_gap
+        over = np.nonzero(np.all((surfaces.bbox[:, 0, :2] <= xy) & (surfaces.bbox[:, 1, :2] >= xy), axis=1))[0]
+        for s in over:
+            beams = self._beam_edges(s)
+            if len(beams) == 0 or not inside_polygon(surfaces.surfaces[s], np.asarray(target_pos)[None])[0]:
+                continue
+            for yaw, lo, hi in beams:
+                along = math.cos(yaw - target_yaw)  # > 0: the axis points along the heading
+                diff = (yaw - target_yaw + 0.5 * math.pi) % math.pi - 0.5 * math.pi
+                outer = 0.5 * (hi - lo) - 0.5 * SOLE_WIDTH - cfg.edge_margin
+                if abs(diff) > cfg.beam_align_yaw or outer < inner:
+                    continue
+                normal = np.array([-math.sin(yaw), math.cos(yaw)])
+                sign = (1.0 if along > 0 else -1.0) * (1.0 if side == LEFT else -1.0)  # the foot's side of the line
+                offset = sign * (float(xy @ normal) - 0.5 * (lo + hi))
+                moved = np.array(target_pos, dtype=np.float64)
+                moved[:2] += (min(max(offset, inner), outer) - offset) * sign * normal
+                return moved
+        return target_pos
+
     def _sole_yaws(self, s: int, target_yaw: float) -> list[float]:
         """Sole yaws (rad) tried on face s: the target's, then the axis of the beam the face
         is (see `beam_width`) closest to it, when they differ by 1 mrad to `beam_align_yaw`."""
-        if s not in self._beam_axes:
-            verts = self.surfaces.surfaces[s].vertices
-            yaws = []
-            for edge in np.roll(verts, -1, axis=0) - verts:
-                axis = edge[:2] / max(math.hypot(edge[0], edge[1]), 1e-12)
-                across = np.ptp(verts[:, :2] @ np.array([-axis[1], axis[0]]))
-                if across < self.config.beam_width:
-                    yaws.append(math.atan2(axis[1], axis[0]))
-            self._beam_axes[s] = np.array(yaws)
-        axes = self._beam_axes[s]
+        axes = self._beam_edges(s)[:, 0]
         if len(axes) == 0 or self.config.beam_align_yaw <= 0.0:
             return [target_yaw]
         # Differences wrapped to [-pi/2, pi/2): an axis has no sense.
@@ -568,6 +610,7 @@ class ContactGenerator:
             return None
         ahead = guide[min(index + int(round(cfg.lookahead / timestep)), len(guide) - 1)]
         target_pos, target_yaw = self._nominal_placement(ahead, side)
+        target_pos = self._beam_lane(side, target_pos, target_yaw)
         # Same candidates, in the same order, as `candidates(...)[:max_candidates]`, but
         # screened a few at a time: the first or second usually gives a posture, and
         # screening all 4 x max_candidates of the pool was a quarter of a plan's time.

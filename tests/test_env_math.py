@@ -56,6 +56,16 @@ def test_actions_accelerate_in_the_root_frame_and_are_clipped():
     assert float(omega) == pytest.approx(-math.pi / 9)
 
 
+def test_vertical_acceleration_has_its_own_bound():
+    import dataclasses
+    config = dataclasses.replace(CFG, vertical_a_max=3.0)
+    accel, _ = kinematics.scale_action(jnp.array([1.0, -0.5, -0.5, 0.0]), jnp.array(0.0), config)
+    # x, y keep a_max = 0.1 m/s^2 per action unit; z: 3.0 m/s^2 per unit (HPP's verticalAccelerationBound)
+    np.testing.assert_allclose(accel, [0.1, -0.05, -1.5], atol=1e-6)
+    _, new_vel, _ = kinematics.integrate(jnp.zeros(3), jnp.zeros(3), jnp.array(0.0), accel, jnp.array(0.0), config)
+    np.testing.assert_allclose(new_vel, [0.01, -0.005, -0.15], atol=1e-6)
+
+
 def test_yaw_wraps_to_minus_pi_pi():
     assert float(kinematics.wrap_angle(jnp.array(3 * math.pi / 2))) == pytest.approx(-math.pi / 2)
 

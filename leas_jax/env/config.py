@@ -110,6 +110,11 @@ class EnvConfig:
     target_speed: float = 0.18  # m/s, paper §IV
     v_max: float = 0.30  # m/s, HPP Talos scripts (vMax)
     a_max: float = 0.10  # m/s^2 per unit action norm, HPP Talos scripts (aMax)
+    # m/s^2 per unit of a_z; None: a_max, one bound for the three axes. The paper gives
+    # no vertical bound; HPP's Talos path planners bound x and y by aMax and z apart,
+    # by Kinodynamic/verticalAccelerationBound (3.0 in hpp-rbprm-corba's talos scenarios,
+    # 10.0 in older scripts). The README's "The environment" section gives its effect.
+    vertical_a_max: float | None = None
     omega_max: float = math.pi / 9.0  # rad/s, thesis of the first author
     # Actions accelerate the root in its own (yaw-rotated) frame. The paper says
     # "accelerations of the robot on each axis" without a frame; the root frame

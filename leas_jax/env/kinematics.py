@@ -24,14 +24,15 @@ def scale_action(action: jax.Array, yaw: jax.Array, config: EnvConfig):
     Args:
         action: [4] (a_x, a_y, a_z, omega), each clipped to [-1, 1].
         yaw: [] root yaw (rad); used when actions are in the root frame.
-        config: a_max, omega_max, action frame.
+        config: a_max (x, y), vertical_a_max (z; None: a_max), omega_max, action frame.
 
     Returns:
         accel: [3] m/s^2, world frame.
         omega: [] rad/s.
     """
     action = jnp.clip(action, -1.0, 1.0)
-    accel = action[:3] * config.a_max
+    vertical = config.a_max if config.vertical_a_max is None else config.vertical_a_max
+    accel = action[:3] * jnp.array([config.a_max, config.a_max, vertical])
     if config.actions_in_root_frame:
         accel = jnp.concatenate([rotate_z(accel[:2], yaw), accel[2:]])
     return accel, action[3] * config.omega_max

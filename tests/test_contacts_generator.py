@@ -146,6 +146,28 @@ def test_bridge_crossed_by_a_guide_off_its_centre_line():
     assert without_lanes.coverage < 1.0 and x_at(without_lanes, without_lanes.last_valid_index) < 2.2
 
 
+@pytest.mark.parametrize("sides, lane", [
+    ("void", True),  # the bridge: void on both sides
+    ("level", False),  # a narrow box of flat ground between two others
+    ("tread", False),  # a stair tread walked along: one side higher, one lower
+])
+def test_beam_lanes_only_where_the_beam_drops_on_both_sides(sides, lane):
+    side_tops = {"void": None, "level": (0.0, 0.0), "tread": (0.15, -0.15)}[sides]
+    text = (HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+            + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    if side_tops is not None:
+        for y, top in zip((1.075, -1.075), side_tops):
+            text += box([3.0, y, (top - 1.0) / 2], [2.0, 1.85, top + 1.0])
+    generator = ContactGenerator(loads_terrain(text))
+    target = np.array([3.0, 0.045, 0.0])  # the left sole's nominal place under a root 4 cm right of the centre line
+    moved = generator._beam_lane(0, target, 0.0)
+    expected = [3.0, 0.13 / 2 + 0.01 / 2, 0.0] if lane else target  # half a sole and half the feet gap
+    np.testing.assert_allclose(moved, expected, atol=1e-9)
+    # walking the other way, the left foot's lane is the other half
+    back = generator._beam_lane(0, np.array([3.0, -0.045, 0.0]), np.pi)
+    np.testing.assert_allclose(back, [3.0, -0.07, 0.0] if lane else [3.0, -0.045, 0.0], atol=1e-9)
+
+
 def test_hole_stops_before_it():
     hole = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([5, 0, -0.1], [4, 4, 0.2]))
     plan = plan_contacts(hole, straight(0.0, 4.0), DT)

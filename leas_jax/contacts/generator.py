@@ -43,8 +43,9 @@ from leas_jax.contacts.ik import leg_ik, leg_ik_single
 from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
                                      load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
-from leas_jax.contacts.surfaces import (SOLE_CORNERS, inside_polygon, sole_corners_world, sole_inside_union, sole_rotation,
-                                        sole_rotation_single, surface_arrays, uncovered)
+from leas_jax.contacts.surfaces import (SOLE_CORNERS, height_at, inside_polygon, sole_corners_world,
+                                        sole_inside_union, sole_rotation, sole_rotation_single, surface_arrays,
+                                        uncovered)
 from leas_jax.errors import UsageError
 
 
@@ -87,6 +88,7 @@ class GeneratorConfig:
     # along such a beam, each foot's step target also moves into its lane (`_beam_lane`).
     beam_width: float = 0.5  # m; the arena's bridges are 0.30-0.45 m wide, its stair treads 0.30 m deep
     beam_align_yaw: float = 0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables (lanes too)
+    beam_drop: float = 0.05  # m, a beam's lanes need terrain this much lower this far beyond both its edges
     # m, sole rectangle kept this far inside the face polygon (DESIGN §6's 5 mm tolerance). Two
     # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin: with 1 cm and 2 cm that was
     # exactly the 0.30 m of eval_bridge, which no guide could cross: a centred straight guide at
@@ -469,8 +471,12 @@ class ContactGenerator:
         edge_margin from its edge, on the foot's side. A guide 4 cm off eval_bridge's 0.30 m
         centre line put the left sole on its nominal place, 4 cm left of the line, where
         the right one no longer fit beside it; with lanes, both feet stay centred and the
-        root's balancing shift absorbs the guide's offset. Faces too narrow for two soles,
-        and other faces, leave the target as it is.
+        root's balancing shift absorbs the guide's offset. A beam here drops on both
+        sides: the terrain `beam_drop` beyond each of its edges, across from the target,
+        is at least `beam_drop` lower. A narrow box of flat ground (its neighbours on a
+        level) or a stair tread (one neighbour higher) is no beam: lanes there put the
+        feet on a tread's far half (arena poses walked from: 3293 -> 3161 before this test).
+        Faces too narrow for two soles, and other faces, leave the target as it is.
         """
         if self.config.beam_align_yaw <= 0.0:
             return target_pos
@@ -489,8 +495,13 @@ class ContactGenerator:
                 if abs(diff) > cfg.beam_align_yaw or outer < inner:
                     continue
                 normal = np.array([-math.sin(yaw), math.cos(yaw)])
+                across = float(xy @ normal)
+                beside = xy + np.outer([lo - cfg.beam_drop - across, hi + cfg.beam_drop - across], normal)  # [2, 2]
+                top = (surfaces.offsets[s] - surfaces.normals[s][:2] @ xy) / surfaces.normals[s][2]  # face at xy
+                if np.any(height_at(self.terrain, beside) > top - cfg.beam_drop):
+                    continue
                 sign = (1.0 if along > 0 else -1.0) * (1.0 if side == LEFT else -1.0)  # the foot's side of the line
-                offset = sign * (float(xy @ normal) - 0.5 * (lo + hi))
+                offset = sign * (across - 0.5 * (lo + hi))
                 moved = np.array(target_pos, dtype=np.float64)
                 moved[:2] += (min(max(offset, inner), outer) - offset) * sign * normal
                 return moved

@@ -25,9 +25,9 @@ class ReachabilityConfig:
     Against the current generator (sixth session: beam lanes), these defaults give
     sensitivity 79.5 %, specificity 89.2 %. The best cylinders at >= 95 % sensitivity give
     94.9 / 85.6 %; with the optional lookahead, foothold and hands terms below, 94.4 / 90.3 %
-    (95.0 / 89.8 % on the fitting poses). The defaults are kept: the stricter setting ends more training
-    episodes, the shipped policy was trained with these, and a false negative only keeps
-    the policy higher than it needs to be. The README's
+    (95.0 / 89.8 % on the fitting poses). The defaults are kept: the stricter setting ends
+    more training episodes, the shipped policy was trained with these, and a false negative
+    only keeps the policy higher than it needs to be. The README's
     "Contact generator" section has the figures and their history.
     """
 
@@ -113,7 +113,8 @@ class EnvConfig:
     # m/s^2 per unit of a_z; None: a_max, one bound for the three axes. The paper gives
     # no vertical bound; HPP's Talos path planners bound x and y by aMax and z apart,
     # by Kinodynamic/verticalAccelerationBound (3.0 in hpp-rbprm-corba's talos scenarios,
-    # 10.0 in older scripts). The README's "The environment" section gives its effect.
+    # 10.0 in older scripts). The effort reward stays in action units. The README's
+    # "The environment" section gives its effect.
     vertical_a_max: float | None = None
     omega_max: float = math.pi / 9.0  # rad/s, thesis of the first author
     # Actions accelerate the root in its own (yaw-rotated) frame. The paper says

@@ -43,9 +43,8 @@ from leas_jax.contacts.ik import leg_ik, leg_ik_single
 from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
                                      load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
-from leas_jax.contacts.surfaces import (SOLE_CORNERS, height_at, inside_polygon, sole_corners_world,
-                                        sole_inside_union, sole_rotation, sole_rotation_single, surface_arrays,
-                                        uncovered)
+from leas_jax.contacts.surfaces import (SOLE_CORNERS, height_at, sole_corners_world, sole_inside_union,
+                                        sole_rotation, sole_rotation_single, surface_arrays, uncovered)
 from leas_jax.errors import UsageError
 
 
@@ -120,6 +119,12 @@ class ContactPosture:
 
 
 _Posture = ContactPosture  # the name the generator's code uses
+
+
+def _axis_difference(axis_yaw, yaw):
+    """Angle (rad) from `yaw` to the undirected axis `axis_yaw`, wrapped to [-pi/2, pi/2)
+    (an axis has no sense). Floats or arrays."""
+    return (axis_yaw - yaw + 0.5 * math.pi) % math.pi - 0.5 * math.pi
 
 
 def _rotz(yaw: float) -> np.ndarray:
@@ -486,11 +491,11 @@ class ContactGenerator:
         over = np.nonzero(np.all((surfaces.bbox[:, 0, :2] <= xy) & (surfaces.bbox[:, 1, :2] >= xy), axis=1))[0]
         for s in over:
             beams = self._beam_edges(s)
-            if len(beams) == 0 or not inside_polygon(surfaces.surfaces[s], np.asarray(target_pos)[None])[0]:
+            if len(beams) == 0 or not surfaces.inside(s, target_pos):
                 continue
             for yaw, lo, hi in beams:
                 along = math.cos(yaw - target_yaw)  # > 0: the axis points along the heading
-                diff = (yaw - target_yaw + 0.5 * math.pi) % math.pi - 0.5 * math.pi
+                diff = _axis_difference(yaw, target_yaw)
                 outer = 0.5 * (hi - lo) - 0.5 * SOLE_WIDTH - cfg.edge_margin
                 if abs(diff) > cfg.beam_align_yaw or outer < inner:
                     continue
@@ -513,8 +518,7 @@ class ContactGenerator:
         axes = self._beam_edges(s)[:, 0]
         if len(axes) == 0 or self.config.beam_align_yaw <= 0.0:
             return [target_yaw]
-        # Differences wrapped to [-pi/2, pi/2): an axis has no sense.
-        diff = (axes - target_yaw + 0.5 * math.pi) % math.pi - 0.5 * math.pi
+        diff = _axis_difference(axes, target_yaw)
         best = float(diff[np.argmin(np.abs(diff))])
         if 1e-3 < abs(best) <= self.config.beam_align_yaw:
             return [target_yaw, target_yaw + best]

@@ -66,6 +66,11 @@ class SurfaceArrays:
     def __len__(self) -> int:
         return len(self.surfaces)
 
+    def inside(self, s: int, points, margin: float = 0.0) -> np.ndarray:
+        """[...] whether points [..., 3] on or near face s's plane lie `margin` m inside its
+        polygon (its cached `edges`; `inside_polygon` without them)."""
+        return _inside_edges(np.asarray(points, dtype=np.float64), self.edges[s], margin)
+
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -181,7 +186,7 @@ def sole_inside_union(surfaces: "SurfaceArrays", faces, pos, rot, margin: float)
         points = (pos[idx, None, :] + np.einsum("nij,pj->npi", rot[idx], subset)).reshape(-1, 3)  # [n P, 3]
         covered = np.zeros(len(points), dtype=bool)
         for s in faces:
-            covered |= _inside_edges(points, surfaces.edges[s], -_INSIDE_TOL)
+            covered |= surfaces.inside(s, points, -_INSIDE_TOL)
         ok[idx] = covered.reshape(len(idx), -1).all(axis=1)
     return ok
 

@@ -55,6 +55,20 @@ def cmd_evaluate(args) -> int:
     return 0
 
 
+def cmd_hole_sweep(args) -> int:
+    from leas_jax.eval.evaluate import parse_methods
+    from leas_jax.eval.sweeps import DEFAULT_METHODS, hole_width_sweep, markdown, parse_widths
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {args.out!r} exists and is not a directory")
+    report = hole_width_sweep(parse_widths(args.widths), parse_methods(args.methods) or DEFAULT_METHODS,
+                              args.checkpoint, args.n_starts, args.workers, out, progress=not args.no_progress)
+    print(markdown(report), end="")
+    print(f"{report['seconds']:.1f} s -> {out}/hole_sweep.json, hole_sweep.md, hole_sweep.png")
+    return 0
+
+
 def register(subparsers) -> None:
     from leas_jax.cli import add_ray_address_argument
 
@@ -83,3 +97,23 @@ def register(subparsers) -> None:
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.set_defaults(func=cmd_evaluate)
+
+    from leas_jax.eval.sweeps import DEFAULT_METHODS, DEFAULT_WIDTHS
+
+    sweep = subparsers.add_parser(
+        "hole-sweep", help="the hole scenario with holes of several widths (how wide a hole LeaS walks round)",
+        description="Run eval_hole's scenario on copies of its terrain whose hole has each given width across the "
+                    "line to the target, and write hole_sweep.json, hole_sweep.md, hole_sweep.png (success against "
+                    "width) and one scenario figure per width.")
+    sweep.add_argument("--widths", default=",".join(f"{w:g}" for w in DEFAULT_WIDTHS), metavar="LIST",
+                       help="comma-separated hole widths in m, each in (0, 7] (default: %(default)s)")
+    sweep.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
+                                                         f"(default: {','.join(DEFAULT_METHODS)})")
+    sweep.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
+    sweep.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
+                       help="starts per width (default: the scenario table's n_starts, 60)")
+    sweep.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
+                       help="contact-generator and RRT processes (default one per CPU; 0: in-process)")
+    sweep.add_argument("--no-progress", action="store_true", help="no progress bars")
+    sweep.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    sweep.set_defaults(func=cmd_hole_sweep)

@@ -548,15 +548,33 @@ def _eval_ground() -> tuple:
     return "Flat ground (paper IV-B.1, Table II): target 4 m ahead of the start region.", bounds, sections, scenario
 
 
-def _eval_hole() -> tuple:
-    """10 x 8 m ground with a 2 x 3 m hole between the start region and the target (§IV-B.2)."""
+EVAL_HOLE_WIDTH = 3.0  # m, across the line to the target (y); the training holes are 0.4-1.2 m
+EVAL_HOLE_LENGTH = 2.0  # m, along the line to the target (x)
+
+
+def _eval_hole(width: float = EVAL_HOLE_WIDTH, length: float = EVAL_HOLE_LENGTH) -> tuple:
+    """10 x 8 m ground, a `width` x `length` hole between the start region and the target (§IV-B.2).
+
+    The hole spans x in [4, 4 + length] and y in [4 - width/2, 4 + width/2]; the starts
+    (x in [1, 2.5]) span the same y range, so the straight line from every start to the
+    target (8.5, 4) crosses the hole's x range beside or inside it.
+    """
+    if not 0.0 < width <= 7.0 or not 0.0 < length <= 4.0:
+        raise ValueError(f"hole width must lie in (0, 7] m and length in (0, 4] m, got {width}, {length}")
     bounds = ((0.0, 0.0), (10.0, 8.0))
-    hole = (4.0, 2.5, 6.0, 5.5)
+    y0, y1 = round(4.0 - width / 2, 4), round(4.0 + width / 2, 4)
+    hole = (4.0, y0, round(4.0 + length, 4), y1)
     ground = [slab(r, 0.0) for r in ground_pieces((0.0, 0.0, 10.0, 8.0), [hole])]
-    sections = [("ground around a hole over x in [4, 6], y in [2.5, 5.5]", ground)]
-    scenario = _scenario((8.5, 4.0), ((1.0, 2.5), (2.5, 5.5)), (-30.0, 30.0))
-    return ("Hole (paper IV-B.2, Fig. 6a): the straight line from most starts to the target "
-            "crosses the hole."), bounds, sections, scenario
+    sections = [(f"ground around a hole over x in [4, {hole[2]:g}], y in [{y0:g}, {y1:g}]", ground)]
+    scenario = _scenario((8.5, 4.0), ((1.0, y0), (2.5, y1)), (-30.0, 30.0))
+    return (f"Hole (paper IV-B.2, Fig. 6a): a {width:g} m wide hole; the straight line from most starts "
+            "to the target crosses it."), bounds, sections, scenario
+
+
+def hole_terrain_toml(width: float, length: float = EVAL_HOLE_LENGTH) -> str:
+    """TOML text of `eval_hole` with another hole size (m); the sweep of `leas hole-sweep`."""
+    description, bounds, sections, scenario = _eval_hole(width, length)
+    return terrain_toml(f"hole_{width:g}m", bounds, sections, header=[description], scenario=scenario)
 
 
 def _eval_bridge() -> tuple:

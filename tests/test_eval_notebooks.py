@@ -64,6 +64,9 @@ def test_scenarios_notebook_runs(run_dir, tmp_path):
     out = tmp_path / "eval"
     notebook = _execute("scenarios.ipynb",
                         {"LEAS_NB_RUN": str(run_dir), "LEAS_NB_N": "1", "LEAS_NB_METHODS": "rblin,leas",
-                         "LEAS_NB_WORKERS": "0", "LEAS_NB_OUT": str(out), "LEAS_NB_TERRAIN": str(terrain)}, tmp_path)
+                         "LEAS_NB_WORKERS": "0", "LEAS_NB_OUT": str(out), "LEAS_NB_TERRAIN": str(terrain),
+                         "LEAS_NB_HOLE_WIDTHS": "0.6"}, tmp_path)
     assert (out / "results.json").is_file() and (out / "flat_scenario.png").is_file()
-    assert "flat_scenario" in _outputs(notebook)
+    assert (out / "hole_sweep" / "hole_sweep.png").is_file()
+    text = _outputs(notebook)
+    assert "flat_scenario" in text and "| 0.6 |" in text

@@ -69,6 +69,20 @@ def cmd_hole_sweep(args) -> int:
     return 0
 
 
+def cmd_arena_check(args) -> int:
+    from leas_jax.eval.arena_check import arena_check, markdown, parse_seeds
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {args.out!r} exists and is not a directory")
+    if args.terrain is not None and not Path(args.terrain).is_file():
+        raise UsageError(f"--terrain: no such file {args.terrain!r}")
+    report = arena_check(args.checkpoint, args.episodes, parse_seeds(args.seeds), terrain_file=args.terrain, out=out)
+    print(markdown(report), end="")
+    print(f"{report['seconds']:.1f} s -> {out}/arena_check.json, arena_check.md, arena_failures.png")
+    return 0
+
+
 def register(subparsers) -> None:
     from leas_jax.cli import add_ray_address_argument
 
@@ -117,3 +131,18 @@ def register(subparsers) -> None:
     sweep.add_argument("--no-progress", action="store_true", help="no progress bars")
     sweep.add_argument("--out", required=True, metavar="DIR", help="output directory")
     sweep.set_defaults(func=cmd_hole_sweep)
+
+    check = subparsers.add_parser(
+        "arena-check", help="speed on eval_ground, safety on the training arena, and why episodes end invalid",
+        description="The foundation's acceptance figures of a policy (deterministic): mean speed along the target "
+                    "direction on eval_ground, the fraction of random arena episodes without an invalid pose per "
+                    "evaluation seed, and for the others the failed reachability term, where the offending terrain "
+                    "lies around the root and the speed at the failure. Writes arena_check.json, arena_check.md and "
+                    "arena_failures.png.")
+    check.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
+    check.add_argument("--episodes", type=_positive_int("--episodes"), default=2048, metavar="N",
+                       help="arena episodes per seed (default: %(default)s)")
+    check.add_argument("--seeds", default="0,1", metavar="LIST", help="evaluation seeds (default: %(default)s)")
+    check.add_argument("--terrain", metavar="FILE", help="the arena (default: the policy's training terrain)")
+    check.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    check.set_defaults(func=cmd_arena_check)

@@ -83,6 +83,17 @@ def cmd_arena_check(args) -> int:
     return 0
 
 
+def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_more: str = "") -> None:
+    """--methods, --checkpoint, --n-starts and --workers of the commands that run scenarios."""
+    parser.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
+                                                          f"(default: {methods_default})")
+    parser.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
+    parser.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
+                        help=f"starts per {starts_per} (default: the scenario table's n_starts, 60)")
+    parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
+                        help=f"contact-generator and RRT processes (default one per CPU; 0: in-process){workers_more}")
+
+
 def register(subparsers) -> None:
     from leas_jax.cli import add_ray_address_argument
 
@@ -95,14 +106,8 @@ def register(subparsers) -> None:
     parser.add_argument("--scenario", metavar="NAME", help=f"{'|'.join(SCENARIOS)}|all, or a comma-separated list")
     parser.add_argument("--terrain", metavar="FILE", help="any terrain file with a [scenario] table (instead of "
                                                           "--scenario)")
-    parser.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
-                                                          "(default: the paper's methods for each scenario)")
-    parser.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
-    parser.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
-                        help="starts per cell (default: the scenario table's n_starts, 60)")
-    parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
-                        help="contact-generator and RRT processes (default one per CPU; 0: in-process), or Ray actors "
-                             "with --ray-address (default: the cluster's CPUs)")
+    _add_run_arguments(parser, "the paper's methods for each scenario", "cell",
+                       ", or Ray actors with --ray-address (default: the cluster's CPUs)")
     add_ray_address_argument(parser, "run the contact generator")
     parser.add_argument("--leas-stop-at-invalid", action="store_true",
                         help="end LeaS paths before the first pose the reachability condition rejects, as training "
@@ -121,13 +126,7 @@ def register(subparsers) -> None:
                     "width) and one scenario figure per width.")
     sweep.add_argument("--widths", default=",".join(f"{w:g}" for w in DEFAULT_WIDTHS), metavar="LIST",
                        help="comma-separated hole widths in m, each in (0, 7] (default: %(default)s)")
-    sweep.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
-                                                         f"(default: {','.join(DEFAULT_METHODS)})")
-    sweep.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
-    sweep.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
-                       help="starts per width (default: the scenario table's n_starts, 60)")
-    sweep.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
-                       help="contact-generator and RRT processes (default one per CPU; 0: in-process)")
+    _add_run_arguments(sweep, ",".join(DEFAULT_METHODS), "width")
     sweep.add_argument("--no-progress", action="store_true", help="no progress bars")
     sweep.add_argument("--out", required=True, metavar="DIR", help="output directory")
     sweep.set_defaults(func=cmd_hole_sweep)

@@ -83,3 +83,13 @@ def test_episode_count_must_be_positive(capsys):
     with pytest.raises(SystemExit) as info:
         main(["arena-check", "--checkpoint", "x", "--episodes", "0", "--out", "o"])
     assert info.value.code == 2 and "--episodes expects an integer >= 1" in capsys.readouterr().err
+
+
+def test_the_run_report_breaks_its_invalid_episodes_down(run_dir, tmp_path):
+    from leas_jax.eval.report import _geometric_section
+
+    lines, results = _geometric_section(run_dir, tmp_path, n_episodes=16)
+    line = next(text for text in lines if text.startswith("Episodes that end invalid"))
+    invalid = round((1 - results["arena_valid_fraction"]) * 16)
+    assert (f"{invalid} episodes. Failed terms:" in line) if invalid else line.endswith("none.")
+    assert (tmp_path / "rollouts_arena.png").is_file()

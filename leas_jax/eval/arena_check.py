@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from leas_jax.errors import UsageError
+from leas_jax.eval.geometric import FailureBreakdown
 
 TERM_COLORS = {"trunk_free": "tab:red", "left_touch": "tab:blue", "right_touch": "tab:green"}
 
@@ -110,12 +111,18 @@ def markdown(report: dict) -> str:
         lines.append(f"| arena: episodes without an invalid pose ({report['episodes']} episodes, seed {seed}) "
                      f"| {100 * arena['valid_fraction']:.1f} % | >= {100 * targets['arena_valid_fraction']:.0f} % |")
     lines += ["", "Episodes that end invalid (first invalid pose):", ""]
-    for seed, arena in report["arena"].items():
-        f = arena["failures"]
-        lines.append(f"- seed {seed}: {f['invalid']} episodes. Failed terms: {_counts(f['terms'])}. Terrain in "
-                     f"the trunk cylinder: {_counts(f['trunk_bearing'])}. Motion: {_counts(f['motion_bearing'])}. "
-                     f"Speed quartiles {f['speed_quartiles']} m/s, step quartiles {f['step_quartiles']}.")
+    lines += [f"- seed {seed}: {failures_line(FailureBreakdown(**arena['failures']))}"
+              for seed, arena in report["arena"].items()]
     return "\n".join(lines) + "\n"
+
+
+def failures_line(failures) -> str:
+    """One Markdown sentence of a `FailureBreakdown`."""
+    if failures.invalid == 0:
+        return "none."
+    return (f"{failures.invalid} episodes. Failed terms: {_counts(failures.terms)}. Terrain in the trunk cylinder: "
+            f"{_counts(failures.trunk_bearing)}. Motion: {_counts(failures.motion_bearing)}. Speed quartiles "
+            f"{failures.speed_quartiles} m/s, step quartiles {failures.step_quartiles}.")
 
 
 def failures_figure(terrain, field, episodes, path: Path, seed: int, config) -> None:

@@ -49,7 +49,8 @@ PLANNER_PANELS = [("mean_coverage", "mean contact-plan coverage"), ("full_covera
 def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[str], dict]:
     """Markdown lines and figures of a geometric run: learning curves, speed and safety, rollouts."""
     from leas_jax.env import heightfield_from_terrain
-    from leas_jax.eval.geometric import arena_episodes, ground_speed
+    from leas_jax.eval.arena_check import failures_line
+    from leas_jax.eval.geometric import arena_episodes, failure_breakdown, ground_speed
     from leas_jax.steering.commands import plot_paths
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import resolve_data_path
@@ -61,7 +62,9 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     if records:
         plot_curves(records, GEOMETRIC_PANELS, out / "learning_curves.png")
     arena = load_terrain(config.terrain_path())
-    episodes = arena_episodes(policy, heightfield_from_terrain(arena, config.env), n=n_episodes, seed=1)
+    field = heightfield_from_terrain(arena, config.env)
+    episodes = arena_episodes(policy, field, n=n_episodes, seed=1)
+    failures = failure_breakdown(field, episodes, config.env.reachability)
     show = min(24, n_episodes)
     colors = ["tab:blue" if episodes.lengths[k] == episodes.poses.shape[1] else "tab:red" for k in range(show)]
     plot_paths(arena, [episodes.poses[k, : episodes.lengths[k]] for k in range(show)],
@@ -100,6 +103,8 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
         f"| {arena.name}: valid episodes that stopped (last 50 steps < 0.1 m) | "
         f"{episodes.stopped_fraction:.3f} | | |",
         f"| {arena.name}: mean progress along the target direction | {episodes.mean_progress:.2f} m | | |",
+        "",
+        f"Episodes that end invalid (`leas arena-check` gives more seeds and a map): {failures_line(failures)}",
         "",
         "![arena](rollouts_arena.png)",
         "",

@@ -276,6 +276,25 @@ def test_slow_leas_climb_of_eval_stairs_is_covered():
     assert verify(plan).ok
 
 
+def test_the_foot_that_can_lead_steps_first_beside_a_void():
+    """A shipped-policy guide of eval_bridge (start 0) sidles left along the start platform,
+    facing the void 2-13 cm ahead, towards the bridge. The right foot's place lies past the
+    left foot: it could only step in place, 1 cm at a time, and being the most lagging it kept
+    doing so while the left foot never moved; at x = 3.87 both feet then lagged out of reach
+    (last valid index 230). Steps that bring a foot nearer its target come first now: the
+    left foot leads, the right follows, and the whole guide is covered."""
+    from leas_jax.eval.scenarios import scenario_file
+    from leas_jax.terrain import load_terrain
+
+    data = np.load(Path(__file__).parent / "data" / "eval_bridge_sidestep_leas_guide.npz")
+    bridge = load_terrain(scenario_file("bridge"))
+    plan = plan_contacts(bridge, data["guide"], float(data["timestep"]))
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    any_step = plan_contacts(bridge, data["guide"], float(data["timestep"]), GeneratorConfig(min_step_gain=None))
+    assert any_step.last_valid_index == 230 and data["guide"][230, 0] < 4.0
+
+
 def test_soles_turn_to_a_narrow_bridge_axis():
     """Crossing the 0.30 m bridge with the root turned 0.3 rad off its axis: soles at the
     guide's yaw take 0.183 m across each, so they fit only staggered; soles turned to the

@@ -23,8 +23,10 @@ Algorithm (DESIGN §6, after the RB-PRM contact generator of Tonneau et al., T-R
    polygon and nothing covers it, then ranked by distance to that target. The step
    adds a single-support posture (foot in the air, NaN row; root shifted over the
    stance sole; balanced on the stance foot alone) and a double-support posture with
-   the foot placed. The other foot is tried if the most lagging one cannot step. At
-   most `max_steps_per_pose` steps per planning pose.
+   the foot placed. The other foot is tried if the most lagging one cannot step;
+   steps that bring their foot nearer its target (`min_step_gain`) are tried on both
+   feet before a step that does not. At most `max_steps_per_pose` steps per planning
+   pose.
 5. The generator stops at the first planning pose it cannot pass; `last_valid_index`
    is the guide index of the last posture, `coverage` its arc-length fraction.
 """
@@ -67,6 +69,13 @@ class GeneratorConfig:
     # (stairs_side: 51 -> 60 of 60), at ~10 % more footsteps on flat ground.
     step_trigger: float = 0.07
     step_trigger_yaw: float = 0.20  # rad, yaw lag that makes a foot step (~ pi/9 rad/s x 0.5 s x 1.15)
+    # Steps that bring their foot nearer its step target come first: the gap (distance /
+    # step_trigger or yaw difference / step_trigger_yaw, the larger) cut by at least this much,
+    # or to under 1. Only when neither foot has such a step may one step with less. Beside the
+    # void on eval_bridge, a guide sidling left kept stepping the right foot in place (its place
+    # past the left foot was out of reach) while the left foot, which could lead, never moved;
+    # both then lagged out of reach. None: any step, the most lagging foot first.
+    min_step_gain: float | None = 0.5
     max_foot_offset: float = 0.25  # m, comfort region: sole to its nominal place in the root frame
     # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward
     max_foot_yaw: float = 0.5
@@ -594,8 +603,20 @@ class ContactGenerator:
         dist, yaw = self._foot_lag(guide_pose, side, pos, rot)
         return max(dist / self.config.step_trigger, yaw / self.config.step_trigger_yaw)
 
-    def _step(self, guide, timestep, index: int, feet, side: int) -> list[_Posture] | None:
-        """Move foot `side` at planning index `index`: [single-support, double-support] postures or None."""
+    def _step_gap(self, pos, rot, target_pos, target_yaw: float) -> float:
+        """How far a sole (pos [3], rot [3, 3]) is from a step target, in step triggers:
+        max(horizontal distance / step_trigger, |yaw difference| / step_trigger_yaw)."""
+        yaw = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+        dist = math.hypot(float(pos[0] - target_pos[0]), float(pos[1] - target_pos[1]))
+        turn = abs((yaw - target_yaw + math.pi) % (2 * math.pi) - math.pi)
+        return max(dist / self.config.step_trigger, turn / self.config.step_trigger_yaw)
+
+    def _step(self, guide, timestep, index: int, feet, side: int,
+              min_gain: float | None = None) -> list[_Posture] | None:
+        """Move foot `side` at planning index `index`: [single-support, double-support] postures or None.
+
+        min_gain: None, or the least cut of the foot's gap to its step target (`_step_gap`)
+        a placement must bring, unless it brings the gap under 1."""
         cfg = self.config
         pose = guide[index]
         other = 1 - side
@@ -630,6 +651,8 @@ class ContactGenerator:
         # screened a few at a time: the first or second usually gives a posture, and
         # screening all 4 x max_candidates of the pool was a quarter of a plan's time.
         pool_pos, pool_rot = self._candidate_pool(side, pose, target_pos, target_yaw, avoid=feet[other])
+        needed = math.inf if min_gain is None else max(1.0, self._step_gap(old_pos, old_rot, target_pos, target_yaw)
+                                                          - min_gain)
         tried = 0
         for start in range(0, len(pool_pos), self._SCREEN_CHUNK):
             chunk = slice(start, start + self._SCREEN_CHUNK)
@@ -639,7 +662,8 @@ class ContactGenerator:
                     return None
                 tried += 1
                 contacts = [stance, (side, pos, rot)]
-                if not self._comfortable(pose, contacts[1:]):
+                if (self._step_gap(pos, rot, target_pos, target_yaw) > needed
+                        or not self._comfortable(pose, contacts[1:])):
                     continue
                 double = self._posture(pose, index, contacts)
                 if double is not None:
@@ -777,15 +801,15 @@ class ContactGenerator:
                 return [keep]
             comfortable = False  # built and failed: not again below
         added: list[_Posture] = []
+        gains = [None] if cfg.min_step_gain is None else [cfg.min_step_gain, None]
         for _ in range(cfg.max_steps_per_pose):
             lag = scores()
-            for side in sorted((LEFT, RIGHT), key=lambda s: -lag[s]):
-                stepped = self._step(guide, timestep, index, feet, side)
-                if stepped is not None:
-                    added.extend(stepped)
-                    break
-            else:
+            order = sorted((LEFT, RIGHT), key=lambda s: -lag[s])
+            stepped = next((postures for gain in gains for side in order
+                            if (postures := self._step(guide, timestep, index, feet, side, gain)) is not None), None)
+            if stepped is None:
                 break
+            added.extend(stepped)
             if self._comfortable(pose, stance()):
                 return added  # its last double-support posture stands at this pose
         if not added and comfortable:

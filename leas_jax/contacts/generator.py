@@ -69,9 +69,9 @@ class GeneratorConfig:
     # (stairs_side: 51 -> 60 of 60), at ~10 % more footsteps on flat ground.
     step_trigger: float = 0.07
     step_trigger_yaw: float = 0.20  # rad, yaw lag that makes a foot step (~ pi/9 rad/s x 0.5 s x 1.15)
-    # Steps that bring their foot nearer its step target come first: the gap (distance /
-    # step_trigger or yaw difference / step_trigger_yaw, the larger) cut by at least this much,
-    # or to under 1. Only when neither foot has such a step may one step with less. Beside the
+    # Steps that bring their foot nearer its step target come first: the horizontal gap, in
+    # step triggers, cut by at least this much, or to under 1. Only when neither foot has such
+    # a step may one step with less. Beside the
     # void on eval_bridge, a guide sidling left kept stepping the right foot in place (its place
     # past the left foot was out of reach) while the left foot, which could lead, never moved;
     # both then lagged out of reach. None: any step, the most lagging foot first.
@@ -603,13 +603,12 @@ class ContactGenerator:
         dist, yaw = self._foot_lag(guide_pose, side, pos, rot)
         return max(dist / self.config.step_trigger, yaw / self.config.step_trigger_yaw)
 
-    def _step_gap(self, pos, rot, target_pos, target_yaw: float) -> float:
-        """How far a sole (pos [3], rot [3, 3]) is from a step target, in step triggers:
-        max(horizontal distance / step_trigger, |yaw difference| / step_trigger_yaw)."""
-        yaw = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
-        dist = math.hypot(float(pos[0] - target_pos[0]), float(pos[1] - target_pos[1]))
-        turn = abs((yaw - target_yaw + math.pi) % (2 * math.pi) - math.pi)
-        return max(dist / self.config.step_trigger, turn / self.config.step_trigger_yaw)
+    def _step_gap(self, pos, target_pos) -> float:
+        """How far a sole at pos [3] is from a step target, in step triggers (horizontal).
+
+        Position only: on a narrow beam soles turn to its axis, away from the target's yaw,
+        and a yaw term made every such step look like no progress."""
+        return math.hypot(float(pos[0] - target_pos[0]), float(pos[1] - target_pos[1])) / self.config.step_trigger
 
     def _step(self, guide, timestep, index: int, feet, side: int,
               min_gain: float | None = None) -> list[_Posture] | None:
@@ -651,8 +650,7 @@ class ContactGenerator:
         # screened a few at a time: the first or second usually gives a posture, and
         # screening all 4 x max_candidates of the pool was a quarter of a plan's time.
         pool_pos, pool_rot = self._candidate_pool(side, pose, target_pos, target_yaw, avoid=feet[other])
-        needed = math.inf if min_gain is None else max(1.0, self._step_gap(old_pos, old_rot, target_pos, target_yaw)
-                                                          - min_gain)
+        needed = math.inf if min_gain is None else max(1.0, self._step_gap(old_pos, target_pos) - min_gain)
         tried = 0
         for start in range(0, len(pool_pos), self._SCREEN_CHUNK):
             chunk = slice(start, start + self._SCREEN_CHUNK)
@@ -662,8 +660,7 @@ class ContactGenerator:
                     return None
                 tried += 1
                 contacts = [stance, (side, pos, rot)]
-                if (self._step_gap(pos, rot, target_pos, target_yaw) > needed
-                        or not self._comfortable(pose, contacts[1:])):
+                if self._step_gap(pos, target_pos) > needed or not self._comfortable(pose, contacts[1:]):
                     continue
                 double = self._posture(pose, index, contacts)
                 if double is not None:

@@ -71,10 +71,10 @@ class GeneratorConfig:
     step_trigger_yaw: float = 0.20  # rad, yaw lag that makes a foot step (~ pi/9 rad/s x 0.5 s x 1.15)
     # Steps that bring their foot nearer its step target come first: the horizontal gap, in
     # step triggers, cut by at least this much, or to under 1. Only when neither foot has such
-    # a step may one step with less. Beside the
-    # void on eval_bridge, a guide sidling left kept stepping the right foot in place (its place
-    # past the left foot was out of reach) while the left foot, which could lead, never moved;
-    # both then lagged out of reach. None: any step, the most lagging foot first.
+    # a step may one step with less. Beside the void on eval_bridge, a guide sidling left kept
+    # stepping the right foot in place (its place past the left foot was out of reach) while
+    # the left foot, which could lead, never moved; both then lagged out of reach.
+    # None: any step, the most lagging foot first.
     min_step_gain: float | None = 0.5
     max_foot_offset: float = 0.25  # m, comfort region: sole to its nominal place in the root frame
     # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward

@@ -379,8 +379,7 @@ class ContactGenerator:
             done.update((surfaces.group[s], yaw) for yaw in yaws)
             normal = surfaces.normals[s]
             # Vertical projection of the target on the face plane: itself a candidate.
-            height = (surfaces.offsets[s] - normal[:2] @ target_pos[:2]) / normal[2]
-            on_plane = np.array([target_pos[0], target_pos[1], height])
+            on_plane = np.array([target_pos[0], target_pos[1], surfaces.plane_height(s, target_pos[:2])])
             local = root_R.T @ (on_plane - root_p)
             xy = (float(local[0]), float(local[1]))
             if xy != disk_xy:
@@ -390,7 +389,7 @@ class ContactGenerator:
             world = np.vstack([on_plane, root_p + db.positions[idx] @ root_R.T])
             # Database samples in a vertical column about the target, dropped vertically
             # on the face (reachability is re-checked exactly by IK below).
-            world[:, 2] = (surfaces.offsets[s] - world[:, :2] @ normal[:2]) / normal[2]
+            world[:, 2] = surfaces.plane_height(s, world[:, :2])
             grouped = len(surfaces.members[surfaces.group[s]]) > 1
             for yaw in yaws:
                 rot = sole_rotation_single(normal, yaw)
@@ -511,8 +510,7 @@ class ContactGenerator:
                 normal = np.array([-math.sin(yaw), math.cos(yaw)])
                 across = float(xy @ normal)
                 beside = xy + np.outer([lo - cfg.beam_drop - across, hi + cfg.beam_drop - across], normal)  # [2, 2]
-                top = (surfaces.offsets[s] - surfaces.normals[s][:2] @ xy) / surfaces.normals[s][2]  # face at xy
-                if np.any(height_at(self.terrain, beside) > top - cfg.beam_drop):
+                if np.any(height_at(self.terrain, beside) > surfaces.plane_height(s, xy) - cfg.beam_drop):
                     continue
                 sign = (1.0 if along > 0 else -1.0) * (1.0 if side == LEFT else -1.0)  # the foot's side of the line
                 offset = sign * (across - 0.5 * (lo + hi))
@@ -611,11 +609,15 @@ class ContactGenerator:
         return math.hypot(float(pos[0] - target_pos[0]), float(pos[1] - target_pos[1])) / self.config.step_trigger
 
     def _step(self, guide, timestep, index: int, feet, side: int,
-              min_gain: float | None = None) -> list[_Posture] | None:
-        """Move foot `side` at planning index `index`: [single-support, double-support] postures or None.
+              min_gain: float | None = None) -> tuple[list[_Posture] | None, bool]:
+        """Move foot `side` at planning index `index`.
 
         min_gain: None, or the least cut of the foot's gap to its step target (`_step_gap`)
-        a placement must bring, unless it brings the gap under 1."""
+        a placement must bring, unless it brings the gap under 1.
+
+        Returns:
+            ([single-support, double-support] postures, or None), and whether `min_gain`
+            passed over a placement (without it the step might succeed)."""
         cfg = self.config
         pose = guide[index]
         other = 1 - side
@@ -642,7 +644,7 @@ class ContactGenerator:
             nearer = self._sole_point_toward(feet[other], pose[:2], cfg.single_support_com_inset)
             single = self._posture(pose, index, [stance], air=(side, lifted), com_target=nearer)
         if single is None:
-            return None
+            return None, False
         ahead = guide[min(index + int(round(cfg.lookahead / timestep)), len(guide) - 1)]
         target_pos, target_yaw = self._nominal_placement(ahead, side)
         target_pos = self._beam_lane(side, target_pos, target_yaw)
@@ -651,21 +653,40 @@ class ContactGenerator:
         # screening all 4 x max_candidates of the pool was a quarter of a plan's time.
         pool_pos, pool_rot = self._candidate_pool(side, pose, target_pos, target_yaw, avoid=feet[other])
         needed = math.inf if min_gain is None else max(1.0, self._step_gap(old_pos, target_pos) - min_gain)
-        tried = 0
+        tried, held_back = 0, False
         for start in range(0, len(pool_pos), self._SCREEN_CHUNK):
             chunk = slice(start, start + self._SCREEN_CHUNK)
             keep = self._screen(side, pose, pool_pos[chunk], pool_rot[chunk])
             for pos, rot in zip(pool_pos[chunk][keep], pool_rot[chunk][keep]):
                 if tried == cfg.max_candidates:
-                    return None
+                    return None, held_back
                 tried += 1
                 contacts = [stance, (side, pos, rot)]
-                if self._step_gap(pos, target_pos) > needed or not self._comfortable(pose, contacts[1:]):
+                if self._step_gap(pos, target_pos) > needed:
+                    held_back = True
+                    continue
+                if not self._comfortable(pose, contacts[1:]):
                     continue
                 double = self._posture(pose, index, contacts)
                 if double is not None:
                     feet[side] = (pos, rot)
-                    return [single, double]
+                    return [single, double], held_back
+        return None, held_back
+
+    def _step_either(self, guide, timestep, index: int, feet, order) -> list[_Posture] | None:
+        """Step one foot, trying the sides in `order`: first with `min_step_gain`, then, on
+        the sides where that test passed a placement over, without it. Postures or None."""
+        retry = []
+        for side in order:
+            stepped, held_back = self._step(guide, timestep, index, feet, side, self.config.min_step_gain)
+            if stepped is not None:
+                return stepped
+            if held_back:
+                retry.append(side)
+        for side in retry:
+            stepped, _ = self._step(guide, timestep, index, feet, side)
+            if stepped is not None:
+                return stepped
         return None
 
     @staticmethod
@@ -798,12 +819,9 @@ class ContactGenerator:
                 return [keep]
             comfortable = False  # built and failed: not again below
         added: list[_Posture] = []
-        gains = [None] if cfg.min_step_gain is None else [cfg.min_step_gain, None]
         for _ in range(cfg.max_steps_per_pose):
             lag = scores()
-            order = sorted((LEFT, RIGHT), key=lambda s: -lag[s])
-            stepped = next((postures for gain in gains for side in order
-                            if (postures := self._step(guide, timestep, index, feet, side, gain)) is not None), None)
+            stepped = self._step_either(guide, timestep, index, feet, sorted((LEFT, RIGHT), key=lambda s: -lag[s]))
             if stepped is None:
                 break
             added.extend(stepped)

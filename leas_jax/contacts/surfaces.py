@@ -66,6 +66,11 @@ class SurfaceArrays:
     def __len__(self) -> int:
         return len(self.surfaces)
 
+    def plane_height(self, s: int, xy) -> np.ndarray:
+        """[...] height of face s's plane above points xy [..., 2] (world, m)."""
+        normal = self.normals[s]
+        return (self.offsets[s] - np.asarray(xy, dtype=np.float64) @ normal[:2]) / normal[2]
+
     def inside(self, s: int, points, margin: float = 0.0) -> np.ndarray:
         """[...] whether points [..., 3] on or near face s's plane lie `margin` m inside its
         polygon (its cached `edges`; `inside_polygon` without them)."""

@@ -264,6 +264,18 @@ def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: 
                 bar.update(1)
 
 
+def policy_for(methods, checkpoint):
+    """The `Policy` of `checkpoint` when `methods` include leas or leas_rrt, else None;
+    UsageError naming --checkpoint when they do and it is None."""
+    if not any(m in LEAS_METHODS for m in methods):
+        return None
+    if checkpoint is None:
+        raise UsageError("--checkpoint is required by the methods leas and leas_rrt")
+    from leas_jax.training.policy import load_policy
+
+    return load_policy(checkpoint)
+
+
 def default_workers() -> int:
     """Processes for the contact generator and the RRT searches: one per CPU this process may use
     (the main process only waits while they work)."""
@@ -362,12 +374,7 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
               for name, _ in jobs}
     if n_starts is not None and n_starts < 1:
         raise UsageError(f"--n-starts: expected a positive integer, got {n_starts}")
-    policy = None
-    if any(m in LEAS_METHODS for ms in wanted.values() for m in ms):
-        if checkpoint is None:
-            raise UsageError("--checkpoint is required by the methods leas and leas_rrt")
-        from leas_jax.training.policy import load_policy
-        policy = load_policy(checkpoint)
+    policy = policy_for({m for ms in wanted.values() for m in ms}, checkpoint)
     if workers is None and address is None:
         workers = default_workers()  # on a Ray cluster, None: one actor per cluster CPU
     if workers is not None and int(workers) < 0:

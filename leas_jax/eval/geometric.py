@@ -9,13 +9,14 @@ directions) that never reach an invalid configuration.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from leas_jax.env import LeasEnv
+from leas_jax.env import LeasEnv, reachability
 from leas_jax.env.field import Heightfield, sample_nearest
 from leas_jax.steering.leas import rollout_batch, start_poses
 
@@ -159,12 +160,15 @@ class FailureBreakdown:
     step_quartiles: list
 
 
-def reachability_terms(field: Heightfield, poses: np.ndarray, config) -> dict:
-    """{term name: bool [N] satisfied} of the reachability condition at poses [N, 4] (jitted)."""
-    from leas_jax.env import reachability
+@functools.partial(jax.jit, static_argnames="config")
+def _terms_at(field: Heightfield, poses: jax.Array, config) -> dict:
+    return jax.vmap(lambda pose: reachability.terms(field, pose, config))(poses)
 
-    evaluate = jax.jit(jax.vmap(lambda pose: reachability.terms(field, pose, config)))
-    return jax.device_get(evaluate(jnp.asarray(poses, jnp.float32)))
+
+def reachability_terms(field: Heightfield, poses: np.ndarray, config) -> dict:
+    """{term name: bool [N] satisfied} of the reachability condition at poses [N, 4] (jitted once
+    per `config` and shape)."""
+    return jax.device_get(_terms_at(field, jnp.asarray(poses, jnp.float32), config))
 
 
 def failure_breakdown(field: Heightfield, episodes: ArenaEpisodes, config) -> FailureBreakdown:

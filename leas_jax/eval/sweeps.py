@@ -30,11 +30,17 @@ MAX_WIDTH = 7.0  # m, the 8 m wide terrain keeps 0.5 m of ground on either side
 def parse_widths(text: str) -> tuple[float, ...]:
     """'0.6,1.2' -> (0.6, 1.2), sorted and unique; a bad entry raises UsageError naming --widths."""
     try:
-        widths = sorted({float(w) for w in text.split(",") if w.strip()})
+        widths = [float(w) for w in text.split(",") if w.strip()]
     except ValueError:
         raise UsageError(f"--widths: expected comma-separated numbers (m), got {text!r}") from None
+    return checked_widths(widths, repr(text))
+
+
+def checked_widths(widths, shown: str) -> tuple[float, ...]:
+    """Widths (m) sorted and unique; UsageError naming --widths (with `shown`) unless all lie in (0, 7]."""
+    widths = sorted({float(w) for w in widths})
     if not widths or widths[0] <= 0.0 or widths[-1] > MAX_WIDTH:
-        raise UsageError(f"--widths: expected widths in (0, {MAX_WIDTH:g}] m, got {text!r}")
+        raise UsageError(f"--widths: expected widths in (0, {MAX_WIDTH:g}] m, got {shown}")
     return tuple(widths)
 
 
@@ -65,17 +71,11 @@ def hole_width_sweep(widths=DEFAULT_WIDTHS, methods=DEFAULT_METHODS, checkpoint=
          "rows": [{"width", "method", "n", "coverage", "success", "errors"}]}, percentages.
     """
     from leas_jax.env import EnvConfig
-    from leas_jax.eval.evaluate import default_workers, run_scenario
-    from leas_jax.eval.scenarios import LEAS_METHODS
+    from leas_jax.eval.evaluate import default_workers, policy_for, run_scenario
 
     began = time.perf_counter()
-    widths = parse_widths(",".join(str(float(w)) for w in widths))
-    policy = None
-    if any(m in LEAS_METHODS for m in methods):
-        if checkpoint is None:
-            raise UsageError("--checkpoint is required by the methods leas and leas_rrt")
-        from leas_jax.training.policy import load_policy
-        policy = load_policy(checkpoint)
+    widths = checked_widths(widths, repr(list(widths)))
+    policy = policy_for(methods, checkpoint)
     workers = default_workers() if workers is None else workers
     env = policy.config.env if policy is not None else EnvConfig()
     rows, results = [], []

@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from leas_jax.env import EnvConfig, FreshResetVmap, LeasEnv, heightfield_from_raster, heightfield_from_terrain
+from leas_jax.env import EnvConfig, FreshResetVmap, RewardWeights, LeasEnv, heightfield_from_raster, heightfield_from_terrain
 from leas_jax.env import reachability
 from leas_jax.terrain import load_terrain
 
@@ -96,6 +96,28 @@ def test_invalid_pose_ends_the_episode():
             break
     assert float(state.done) == 1.0 and float(state.metrics["invalid"]) == 1.0
     assert float(state.info["truncation"]) == 0.0
+
+
+def test_clearance_term_is_off_by_default_and_costs_its_weight_near_the_edge():
+    """Solid ground up to x = 2.18 m, then void. A leg disk (r 0.05 m) at x = 2.14 m touches it;
+    the probe shifted 0.10 m ahead (x = 2.24 m) does not, so the clearance term is -1/6 and the
+    reward drops by its weight."""
+    heights = np.zeros((201, 201), np.float32)
+    heights[110:, :] = -2.0
+    pose = jnp.array([2.14, 2.0, 1.0, 0.0])
+    stand = jnp.zeros(4)
+
+    def first_step(config):
+        env = LeasEnv(heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0, config), config)
+        return env.step(env.reset_to(pose, 0.0, target_dir=jnp.array([1.0, 0.0])), stand)
+
+    paper = first_step(EnvConfig())
+    assert float(paper.metrics["reward/clearance"]) == 0.0
+    weighted = EnvConfig(rewards=RewardWeights(clearance=2.0), clearance_margin=0.10)
+    near = first_step(weighted)
+    assert float(near.metrics["invalid"]) == 0.0
+    assert float(near.metrics["reward/clearance"]) == pytest.approx(-1.0 / 6.0)
+    assert float(near.reward) == pytest.approx(float(paper.reward) - 2.0 / 6.0, abs=1e-6)
 
 
 def test_observation_velocity_is_in_the_root_frame():

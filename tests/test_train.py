@@ -7,9 +7,10 @@ import jax
 import numpy as np
 import pytest
 
-from leas_jax.env import heightfield_from_raster
+from leas_jax.env import EnvConfig, heightfield_from_raster
 from leas_jax.errors import LeasError, UsageError
 from leas_jax.training import TrainConfig, load_policy, preset, train
+from leas_jax.training.config import pretraining_config
 from leas_jax.training import checkpoint
 
 
@@ -30,6 +31,11 @@ def field():
 def test_presets_and_validation():
     assert preset("paper").num_timesteps == 80_000_000
     assert preset("quick").hidden_sizes == (64, 64)
+    # the paper's five reward terms in `paper`; `quick` adds clearance, in both phases and its pretraining
+    assert preset("paper").env.rewards.clearance == 0.0 and preset("paper", mode="planner").env == EnvConfig()
+    quick_planner = preset("quick", mode="planner")
+    assert preset("quick").env.rewards.clearance > 0.0
+    assert quick_planner.env == preset("quick").env == pretraining_config(quick_planner).env
     with pytest.raises(UsageError, match="unknown preset 'fast'"):
         preset("fast")
     with pytest.raises(UsageError, match="num_envs"):

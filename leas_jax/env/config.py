@@ -99,6 +99,11 @@ class RewardWeights:
     effort_orientation: float = 0.1  # w_eff_ori
     effort_acceleration: float = 0.1  # w_eff_acc
     alive: float = 1.0  # w_alive
+    # Not in the paper (0 disables it): w_clear, weight of the clearance term
+    # (`reachability.clearance_shortfall`): minus the fraction of the six poses shifted by
+    # `EnvConfig.clearance_margin` along the root frame's axes that are invalid. It warns
+    # the policy before a near-miss instead of only ending the episode at one.
+    clearance: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -128,6 +133,8 @@ class EnvConfig:
     nominal_root_height: float = 1.0  # m
     target_reached_distance: float = 0.20  # m, epsilon of the evaluation termination (DESIGN §5)
     stop_at_target: bool = False  # evaluation mode: end an episode when the root is within epsilon
+    # m, shift of the clearance term's six probe poses (used when rewards.clearance != 0)
+    clearance_margin: float = 0.05
     reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
     reachability: ReachabilityConfig = field(default_factory=ReachabilityConfig)
     heightmap: HeightmapConfig = field(default_factory=HeightmapConfig)

@@ -107,7 +107,7 @@ class LeasEnv(Env):
                      metrics=metrics, info={"truncation": truncation})
 
     def _zero_metrics(self) -> dict:
-        names = ("direction", "orientation", "effort_orientation", "effort_acceleration", "alive")
+        names = ("direction", "orientation", "effort_orientation", "effort_acceleration", "alive", "clearance")
         metrics = {f"reward/{n}": jnp.zeros(()) for n in names}
         metrics.update(invalid=jnp.zeros(()), reached=jnp.zeros(()))
         return metrics
@@ -191,6 +191,9 @@ class LeasEnv(Env):
 
         terms = reward.terms(vel, yaw, action, target_dir, cfg)
         ok = reachability.valid(self.field, root.pose, cfg.reachability)
+        terms["clearance"] = (-reachability.clearance_shortfall(self.field, root.pose, cfg.clearance_margin,
+                                                                 cfg.reachability)
+                              if cfg.rewards.clearance != 0.0 else jnp.zeros(()))
         reached = root.follow_point & (jnp.linalg.norm(root.target_point - pos[:2]) < cfg.target_reached_distance)
         reached = reached & cfg.stop_at_target
         timeout = steps >= cfg.episode_length

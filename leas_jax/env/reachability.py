@@ -114,3 +114,15 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
 def valid(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
     """True when the root pose satisfies the reachability condition. pose: [4] -> bool[]."""
     return jnp.all(jnp.stack(list(terms(field, pose, config).values())))
+
+
+def clearance_shortfall(field: Heightfield, pose: jax.Array, margin: float,
+                        config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
+    """Fraction of the six poses shifted by `margin` (m) along the root frame's x, y and z
+    axes, both ways, that violate the condition: 0 when the pose keeps `margin` of room in
+    every direction, up to 1. pose: [4] (x, y, z, yaw), world -> float[]."""
+    shifts = margin * jnp.concatenate([jnp.eye(3), -jnp.eye(3)])  # [6, 3], root frame
+    world = jnp.concatenate([rotate_z(shifts[:, :2], pose[3]), shifts[:, 2:]], axis=1)
+    probes = pose + jnp.concatenate([world, jnp.zeros((6, 1))], axis=1)
+    ok = jax.vmap(lambda probe: valid(field, probe, config))(probes)
+    return 1.0 - ok.mean()

@@ -24,6 +24,7 @@ def terms(vel: jax.Array, yaw: jax.Array, action: jax.Array, target_dir: jax.Arr
           effort_orientation  = -(omega / omega_max)^2
           effort_acceleration = -(|a| / a_max)^2
           alive = 1
+        The clearance term needs the terrain: `LeasEnv.transition` adds it.
     """
     action = jnp.clip(action, -1.0, 1.0)
     desired = jnp.concatenate([config.target_speed * target_dir, jnp.zeros(1)])
@@ -42,5 +43,6 @@ def total(reward_terms: dict, config: EnvConfig) -> jax.Array:
     w = config.rewards
     weights = {"direction": w.direction, "orientation": w.orientation,
                "effort_orientation": w.effort_orientation,
-               "effort_acceleration": w.effort_acceleration, "alive": w.alive}
+               "effort_acceleration": w.effort_acceleration, "alive": w.alive,
+               "clearance": w.clearance}
     return sum(weights[name] * value for name, value in reward_terms.items())

@@ -45,7 +45,7 @@ def resolve_data_path(path: str | Path) -> Path:
 
 @dataclass(frozen=True)
 class TrainConfig:
-    """PPO training configuration (geometric mode). Defaults: the `quick` preset."""
+    """PPO training configuration. Field defaults: Table I and the paper's MDP; `preset(name)` gives the presets."""
 
     preset: str = "quick"
     # "geometric": PPO on the reachability condition alone; "planner": the paper's
@@ -141,13 +141,20 @@ class TrainConfig:
         return TrainConfig(env=EnvConfig(**env_kwargs), **data)
 
 
+# The `quick` presets add the clearance reward term (not in the paper, whose five terms
+# `paper` keeps): minus the fraction of the six root poses shifted by 0.10 m along the root
+# frame's axes that fail the reachability condition. Without it, `quick` policies end 11-17 %
+# of training-arena episodes on an invalid pose, mostly near-misses while creeping beside
+# walls, pillars and stairs (`leas arena-check`); with it, see the README's "Training" section.
+QUICK_ENV = EnvConfig(rewards=RewardWeights(clearance=1.0), clearance_margin=0.10)
+
 PRESETS = {
     # under a minute on 2 cores, compile included: checks that everything runs
     "smoke": dict(num_timesteps=400_000, num_envs=512, unroll_length=16, num_minibatches=4,
                   num_epochs=4, iterations_per_call=4),
     # the paper's 80 M-step budget in about 7 minutes on 2 cores: 3 epochs of 8
     # mini-batches (benchmarks/train_throughput.py: 176-185 k env steps/s here at load 1.5)
-    "quick": dict(num_timesteps=80_000_000, num_epochs=3, num_minibatches=8),
+    "quick": dict(num_timesteps=80_000_000, num_epochs=3, num_minibatches=8, env=QUICK_ENV),
     # the paper's budget and sample reuse: 80 M steps, 10 epochs (Table I), ~25 minutes here
     "paper": dict(num_timesteps=80_000_000, num_epochs=10, num_minibatches=8),
 }
@@ -166,7 +173,8 @@ PRESETS = {
 # (docs/results/make-run-2026-11-22-planner-500k).
 PLANNER_PRESETS = {
     "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
-    "quick": dict(num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick"),
+    "quick": dict(num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick",
+                  env=QUICK_ENV),
     "paper": dict(num_timesteps=600_000, num_envs=64, num_minibatches=4, num_epochs=10, pretrain="paper"),
 }
 
@@ -177,7 +185,8 @@ def pretraining_config(config: TrainConfig) -> TrainConfig:
 
 
 def preset(name: str, mode: str = "geometric", **overrides) -> TrainConfig:
-    """A preset's config for `mode` with keyword overrides; unknown names raise UsageError."""
+    """A preset's config for `mode` with keyword overrides; unknown names raise UsageError.
+    An `env` override replaces the preset's whole EnvConfig (`quick`'s is QUICK_ENV)."""
     table = PLANNER_PRESETS if mode == "planner" else PRESETS
     if name not in table:
         raise UsageError(f"unknown preset {name!r}; choose one of {', '.join(table)}")

@@ -84,7 +84,8 @@ def cmd_arena_check(args) -> int:
 
 
 def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_more: str = "") -> None:
-    """--methods, --checkpoint, --n-starts and --workers of the commands that run scenarios."""
+    """--methods, --checkpoint, --n-starts, --workers, --no-progress and --out of the commands that run
+    scenarios."""
     parser.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
                                                           f"(default: {methods_default})")
     parser.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
@@ -92,6 +93,8 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
                         help=f"starts per {starts_per} (default: the scenario table's n_starts, 60)")
     parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
                         help=f"contact-generator and RRT processes (default one per CPU; 0: in-process){workers_more}")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
 
 
 def register(subparsers) -> None:
@@ -113,8 +116,6 @@ def register(subparsers) -> None:
                         help="end LeaS paths before the first pose the reachability condition rejects, as training "
                              "episodes end (default: the policy rolls on and the contact generator alone judges its "
                              "paths, as it judges the baselines' paths)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
     parser.set_defaults(func=cmd_evaluate)
 
     from leas_jax.eval.sweeps import DEFAULT_METHODS, DEFAULT_WIDTHS
@@ -127,8 +128,6 @@ def register(subparsers) -> None:
     sweep.add_argument("--widths", default=",".join(f"{w:g}" for w in DEFAULT_WIDTHS), metavar="LIST",
                        help="comma-separated hole widths in m, each in (0, 7] (default: %(default)s)")
     _add_run_arguments(sweep, ",".join(DEFAULT_METHODS), "width")
-    sweep.add_argument("--no-progress", action="store_true", help="no progress bars")
-    sweep.add_argument("--out", required=True, metavar="DIR", help="output directory")
     sweep.set_defaults(func=cmd_hole_sweep)
 
     check = subparsers.add_parser(

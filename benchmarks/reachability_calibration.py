@@ -35,7 +35,8 @@ flatness term (`foothold_radius`, `foothold_search`, `foothold_spread`) of
 raster per setting); both bests are reported, and the NumPy form of each is checked
 against the jitted condition. A third search (`HANDS_GRID`) adds the hands term
 (`hand_radius`, `hand_bottom`: the half-sitting grippers beside the trunk cylinder) to
-the setting the second one chose, with the same thresholds grid.
+the radii and foothold the second one chose, over every lookahead of `TERMS_GRID`, with
+the same thresholds grid. Its best is the ReachabilityConfig default.
 
 Selection: parameters that keep a root at 1.0 m and at NOMINAL_ROOT_HEIGHT (1.019 m)
 above flat ground valid with >= 2 cm margins (the environment's spawn logic needs it);
@@ -97,16 +98,18 @@ GRID = {
 TERMS_GRID = {
     "trunk_radius": (0.20, 0.30),
     "leg_radius": (0.05,),
-    "leg_forward": (0.0, 0.06, 0.12, 0.18, 0.24),
+    "leg_forward": (0.0, 0.06, 0.12, 0.18, 0.24, 0.30, 0.36),
     "foothold": (None, (0.065, 0.10), (0.08, 0.10), (0.10, 0.10)),
     "foothold_spread": (0.01, 0.02, 0.04),
 }
 # Grid of the hands term (`hand_radius`, `hand_bottom`; hand centres at the defaults of
 # ReachabilityConfig, from the model's grippers), searched with the thresholds of GRID on
-# the radii, lookahead and foothold chosen by the search with TERMS_GRID. None: term off.
+# the radii and foothold chosen by the search with TERMS_GRID and every lookahead of
+# TERMS_GRID (the best lookahead with the hands is not the best without them: 0.30 against
+# 0.24 m). None: term off.
 HANDS_GRID = {
-    "hand": (None, 0.10, 0.13, 0.16),
-    "hand_bottom": (-0.45, -0.40, -0.35, -0.30),
+    "hand": (None, 0.10, 0.13, 0.16, 0.20, 0.24),
+    "hand_bottom": (-0.45, -0.40, -0.35, -0.30, -0.25),
 }
 
 
@@ -514,6 +517,7 @@ def main(argv=None) -> None:
     from common import save
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
+    from leas_jax.training.config import TRAINING_REACHABILITY
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--poses", type=int, default=12000)
@@ -531,12 +535,13 @@ def main(argv=None) -> None:
 
     terrain = load_terrain(args.terrain)
     # DESIGN §5 values: the defaults before this calibration.
+    no_terms = dict(leg_forward=0.0, foothold_spread=None, hand_radius=None)
     old = ReachabilityConfig(trunk_radius=0.30, trunk_bottom=-0.63, trunk_top=0.60, leg_radius=0.25,
-                             leg_lateral_offset=0.085, leg_bottom=-1.06, leg_top=-0.54)
+                             leg_lateral_offset=0.085, leg_bottom=-1.06, leg_top=-0.54, **no_terms)
     if args.baseline:
         tr, tb, tt, lr, lb, lt = map(float, args.baseline.split(","))
         old = ReachabilityConfig(trunk_radius=tr, trunk_bottom=tb, trunk_top=tt, leg_radius=lr, leg_bottom=lb,
-                                 leg_top=lt)
+                                 leg_top=lt, **no_terms)
     poses = sample_poses(terrain, args.poses, args.seed)
     suffix = "" if args.truth == "static" else f"_{args.truth}"
     truth, gt_seconds = cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse)
@@ -555,7 +560,7 @@ def main(argv=None) -> None:
     with_terms = terms_search["config"]
     start = time.perf_counter()
     hands_grid = {"trunk_radius": (with_terms.trunk_radius,), "leg_radius": (with_terms.leg_radius,),
-                  "leg_forward": (with_terms.leg_forward,),
+                  "leg_forward": TERMS_GRID["leg_forward"],
                   "foothold": (None if with_terms.foothold_spread is None else
                                (with_terms.foothold_radius, with_terms.foothold_search),),
                   "foothold_spread": (with_terms.foothold_spread,), **HANDS_GRID}
@@ -568,6 +573,7 @@ def main(argv=None) -> None:
     hands_figures, hands_pred = figures(terrain, poses, truth, with_hands, fit)
     current = ReachabilityConfig()
     current_figures, current_pred = figures(terrain, poses, truth, current, fit)
+    training_figures, _ = figures(terrain, poses, truth, TRAINING_REACHABILITY, fit)
     # The NumPy thresholds of the searches must agree with the jitted condition.
     mismatch = 0
     for cfg, pred in ((new, new_pred), (with_terms, terms_pred), (with_hands, hands_pred)):
@@ -611,7 +617,8 @@ def main(argv=None) -> None:
     for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new (cylinders only)", new, new_figures),
                            ("new with the optional terms", with_terms, terms_figures),
                            ("new with the optional terms and the hands", with_hands, hands_figures),
-                           ("current EnvConfig defaults", current, current_figures)):
+                           ("current EnvConfig defaults", current, current_figures),
+                           ("training presets (TRAINING_REACHABILITY)", TRAINING_REACHABILITY, training_figures)):
         print(f"{name}: {_describe(cfg)}")
         for part in ("all", "fit", "held_out"):
             print(f"  {part:9s} {_fmt(fig[part])}")
@@ -643,9 +650,9 @@ def main(argv=None) -> None:
         "hands_sensitivity_target_met_on_fit": hands_search["sensitive"],
         "chosen": as_dict(new), "chosen_with_terms": as_dict(with_terms), "chosen_with_hands": as_dict(with_hands),
         "old": as_dict(old),
-        "current": as_dict(current),
+        "current": as_dict(current), "training": as_dict(TRAINING_REACHABILITY),
         "figures": {"old": old_figures, "new": new_figures, "new_with_terms": terms_figures,
-                    "new_with_hands": hands_figures, "current": current_figures},
+                    "new_with_hands": hands_figures, "current": current_figures, "training": training_figures},
         "by_height_offset": {"old": breakdown(poses, truth, old_pred, terrain),
                              "new": breakdown(poses, truth, new_pred, terrain),
                              "new_with_terms": breakdown(poses, truth, terms_pred, terrain),

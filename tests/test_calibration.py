@@ -167,7 +167,7 @@ def test_hands_term_catches_grippers_beside_the_wall():
     poses = np.concatenate([POSES[:16], side])
     truth = rc.ground_truth(TERRAIN, poses, workers=1)
     assert truth[:16].all() and not truth[16:].any()
-    base = ReachabilityConfig()
+    base = ReachabilityConfig(leg_forward=0.0, hand_radius=None)  # the default cylinders alone
     assert rc.condition(TERRAIN, poses, base).all()  # every pose passes without the hands
     hands = dataclasses.replace(base, hand_radius=0.13)
     predicted = rc.condition(TERRAIN, poses, hands)

@@ -1,5 +1,6 @@
 """LeasEnv: smoke test on every committed terrain, resets, targets, termination."""
 
+import dataclasses
 from pathlib import Path
 
 import jax
@@ -10,6 +11,7 @@ import pytest
 from leas_jax.env import EnvConfig, FreshResetVmap, RewardWeights, LeasEnv, heightfield_from_raster, heightfield_from_terrain
 from leas_jax.env import reachability
 from leas_jax.terrain import load_terrain
+from leas_jax.training.config import TRAINING_ENV
 
 TERRAINS = sorted(Path(__file__).resolve().parents[1].glob("terrains/*.toml"))
 
@@ -111,9 +113,9 @@ def test_clearance_term_is_off_by_default_and_costs_its_weight_near_the_edge():
         env = LeasEnv(heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0, config), config)
         return env.step(env.reset_to(pose, 0.0, target_dir=jnp.array([1.0, 0.0])), stand)
 
-    paper = first_step(EnvConfig())
+    paper = first_step(TRAINING_ENV)  # the presets' condition (the default's lookahead legs would be over the void)
     assert float(paper.metrics["reward/clearance"]) == 0.0
-    weighted = EnvConfig(rewards=RewardWeights(clearance=2.0), clearance_margin=0.10)
+    weighted = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=2.0), clearance_margin=0.10)
     near = first_step(weighted)
     assert float(near.metrics["invalid"]) == 0.0
     assert float(near.metrics["reward/clearance"]) == pytest.approx(-1.0 / 6.0)

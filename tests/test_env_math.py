@@ -173,19 +173,22 @@ def test_reachability_terms_name_the_failure(scene):
 
 
 def test_clearance_shortfall_counts_the_probes_that_fail(scene):
-    """The wall's last raster column is x = 1.18: at x = 1.50 the trunk disk (r 0.30) is 0.32 m from
-    it, free; shifted 0.05 m towards the wall it is 0.27 m from it. One of the six probes fails,
-    whichever way the root faces; in the open, none at 0.05 m; beside the wall too close, the pose itself
-    fails and so do most probes."""
+    """With the presets' condition (TRAINING_REACHABILITY: the cylinders alone, the trunk from
+    0.825 m below the root). The wall's last raster column is x = 1.18: at x = 1.50 the trunk
+    disk (r 0.30) is 0.32 m from it, free; shifted 0.05 m towards the wall it is 0.27 m from it.
+    One of the six probes fails, whichever way the root faces; in the open, none at 0.05 m;
+    beside the wall too close, the pose itself fails and so do most probes."""
+    from leas_jax.training.config import TRAINING_REACHABILITY as reach
+
     for yaw in (0.0, math.pi):
         p = pose(1.50, 7.0, 1.0, yaw)
-        assert bool(reachability.valid(scene, p))
-        assert float(reachability.clearance_shortfall(scene, p, 0.05)) == pytest.approx(1.0 / 6.0)
-    assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.05)) == 0.0
+        assert bool(reachability.valid(scene, p, reach))
+        assert float(reachability.clearance_shortfall(scene, p, 0.05, reach)) == pytest.approx(1.0 / 6.0)
+    assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.05, reach)) == 0.0
     # 0.2 m up, the legs (down to 1.175 m below the root) miss the ground; 0.2 m down, the
     # trunk (from 0.825 m below the root) enters it
-    assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.2)) == pytest.approx(2.0 / 6.0)
-    assert float(reachability.clearance_shortfall(scene, pose(1.40, 7.0, 1.0), 0.05)) >= 0.5
+    assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.2, reach)) == pytest.approx(2.0 / 6.0)
+    assert float(reachability.clearance_shortfall(scene, pose(1.40, 7.0, 1.0), 0.05, reach)) >= 0.5
 
 
 def test_leg_cylinders_turn_with_the_yaw():
@@ -196,7 +199,7 @@ def test_leg_cylinders_turn_with_the_yaw():
 def test_nearest_sampling_of_rasters():
     heights = flat(1.0)
     heights[cell(0.5), cell(0.5)] = 1.0
-    field = field_of(heights)
+    field = field_of(heights, require_spawn=False)  # 1 m wide: the hands and lookahead reach past it
     assert float(sample_nearest(field, field.heights, jnp.array([0.505, 0.495]))) == 1.0
     assert float(sample_nearest(field, field.heights, jnp.array([-0.5, 0.5]))) == -2.0
 

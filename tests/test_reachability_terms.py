@@ -1,7 +1,9 @@
 """Hand-made cases for the optional terms of the reachability condition (issue 3 item 6):
 the lookahead leg cylinders (`leg_forward`), the foothold flatness term
 (`foothold_radius`, `foothold_search`, `foothold_spread`) and the hands term
-(`hand_radius`, `hand_forward`, `hand_lateral`, `hand_bottom`). All are off by default.
+(`hand_radius`, `hand_forward`, `hand_lateral`, `hand_bottom`). The calibrated default
+turns the lookahead and the hands on; each term is tested here added to PLAIN, the
+default cylinders alone.
 
 Terrains are 4 x 4 m rasters (2 cm cells, void at -2 m, world origin at the raster's
 corner); roots stand 1.0 m above the ground, where the default condition holds.
@@ -24,6 +26,12 @@ from leas_jax.env.field import foothold_raster
 RES = 0.02
 VOID = -2.0
 SIZE = 201  # cells per side: 4 m
+PLAIN = ReachabilityConfig(leg_forward=0.0, foothold_spread=None, hand_radius=None)  # cylinders only
+
+
+def plain_with(**terms) -> ReachabilityConfig:
+    """PLAIN with the given optional terms."""
+    return dataclasses.replace(PLAIN, **terms)
 
 
 def cell(x):
@@ -60,20 +68,26 @@ def ridged_terrain():
     return heights
 
 
-def test_defaults_disable_both_terms():
+def test_defaults_turn_on_the_lookahead_and_the_hands_only():
     reach = ReachabilityConfig()
-    assert reach.leg_forward == 0.0 and reach.foothold_spread is None
+    assert reach.leg_forward == 0.30 and reach.hand_radius == 0.13 and reach.foothold_spread is None
     heights = np.zeros((SIZE, SIZE), np.float32)
     field = field_of(heights, reach, require_spawn=True)
     assert field.foothold.shape == (1, 1)  # no raster when the term is off
+    assert field.hand_max.shape == field.heights.shape
     t = reachability.terms(field, pose(1.0, 1.0), reach)
-    assert all(bool(t[k]) for k in ("left_ahead_touch", "right_ahead_touch", "left_foothold", "right_foothold"))
+    assert all(bool(v) for v in t.values())
+    plain = field_of(heights, PLAIN)
+    assert plain.hand_max.shape == (1, 1)
+    t = reachability.terms(plain, pose(1.0, 1.0), PLAIN)
+    assert all(bool(t[k]) for k in ("left_ahead_touch", "right_ahead_touch", "left_foothold", "right_foothold",
+                                    "left_hand_free", "right_hand_free"))
 
 
 # -- lookahead legs -----------------------------------------------------------
 
 def test_lookahead_rejects_a_root_facing_a_cliff(hole_terrain):
-    plain = ReachabilityConfig()
+    plain = PLAIN
     ahead = dataclasses.replace(plain, leg_forward=0.15)
     field = field_of(hole_terrain, ahead)
     # 0.10 m from the edge, facing it: the legs stand on the ground, the lookahead legs over the void.
@@ -90,25 +104,25 @@ def test_lookahead_rejects_a_root_facing_a_cliff(hole_terrain):
 
 
 def test_lookahead_centres_turn_with_the_yaw():
-    reach = ReachabilityConfig(leg_forward=0.2)
+    reach = plain_with(leg_forward=0.2)
     centres = reachability.all_leg_centers(pose(1.0, 1.0, yaw=math.pi / 2), reach)
     np.testing.assert_allclose(centres, [[1.0 - 0.085, 1.0], [1.0 + 0.085, 1.0],
                                          [1.0 - 0.085, 1.2], [1.0 + 0.085, 1.2]], atol=1e-6)
-    assert reachability.all_leg_centers(pose(1.0, 1.0), ReachabilityConfig()).shape == (2, 2)
+    assert reachability.all_leg_centers(pose(1.0, 1.0), PLAIN).shape == (2, 2)
 
 
 def test_lookahead_legs_use_the_band():
     # A step down 0.10 m ahead: the lookahead legs' ground is 1.10 m below the root, inside
-    # the band [leg_bottom, leg_top] = [-1.175, -0.55]; a 0.20 m step down puts it 1.20 m
+    # the band [leg_bottom, leg_top] = [-1.175, -0.75]; a 0.20 m step down puts it 1.20 m
     # below, out of reach. The legs themselves stand on the upper ground (1.0 m below).
     heights = np.zeros((SIZE, SIZE), np.float32)
     heights[cell(2.0):, :] = -0.10
-    ahead = ReachabilityConfig(leg_forward=0.15)
+    ahead = plain_with(leg_forward=0.15)
     assert valid(field_of(heights, ahead), pose(1.90, 2.0), ahead)
     heights[cell(2.0):, :] = -0.20
     field = field_of(heights, ahead)
     assert not valid(field, pose(1.90, 2.0), ahead)
-    assert valid(field, pose(1.90, 2.0), ReachabilityConfig())
+    assert valid(field, pose(1.90, 2.0), PLAIN)
 
 
 # -- foothold -----------------------------------------------------------------
@@ -129,10 +143,10 @@ def test_foothold_raster_by_hand():
 
 
 def test_foothold_rejects_uneven_ground(ridged_terrain):
-    reach = ReachabilityConfig(foothold_radius=0.08, foothold_search=0.10, foothold_spread=0.02)
+    reach = plain_with(foothold_radius=0.08, foothold_search=0.10, foothold_spread=0.02)
     field = field_of(ridged_terrain, reach)
     on_ridges = pose(3.0, 2.0, z=1.02)
-    assert valid(field, on_ridges, ReachabilityConfig())  # the plain condition accepts it
+    assert valid(field, on_ridges, PLAIN)  # the cylinders alone accept it
     assert not valid(field, on_ridges, reach)
     t = reachability.terms(field, on_ridges, reach)
     assert not bool(t["left_foothold"]) and not bool(t["right_foothold"]) and bool(t["left_touch"])
@@ -148,25 +162,25 @@ def test_foothold_beside_a_hole_needs_the_search(hole_terrain):
     # Legs 0.03 m from the void: a sole disk of 0.08 m there hangs over the void; searching
     # 0.10 m around finds one on the ground.
     at_edge = pose(1.97, 2.0, yaw=0.0)  # legs at (1.97, 2.0 +- 0.085), the edge at x = 2.0
-    strict = ReachabilityConfig(foothold_radius=0.08, foothold_search=0.0, foothold_spread=0.02)
+    strict = plain_with(foothold_radius=0.08, foothold_search=0.0, foothold_spread=0.02)
     search = dataclasses.replace(strict, foothold_search=0.10)
     assert not valid(field_of(hole_terrain, strict), at_edge, strict)
     assert valid(field_of(hole_terrain, search), at_edge, search)
 
 
 def test_foothold_needs_its_raster(ridged_terrain):
-    reach = ReachabilityConfig(foothold_spread=0.02)
-    field = field_of(ridged_terrain, ReachabilityConfig())  # built without the term
+    reach = plain_with(foothold_spread=0.02)
+    field = field_of(ridged_terrain, PLAIN)  # built without the term
     with pytest.raises(ValueError, match="foothold"):
         reachability.valid(field, pose(1.0, 2.0), reach)
 
 
 def test_spawn_points_keep_the_foothold(ridged_terrain):
-    reach = ReachabilityConfig(foothold_spread=0.02, leg_forward=0.1)
+    reach = plain_with(foothold_spread=0.02, leg_forward=0.1)
     field = field_of(ridged_terrain, reach, require_spawn=True)
     spawn = np.asarray(field.spawn_xy)
     assert len(spawn) > 0 and np.all(spawn[:, 0] <= 2.0)  # never over the ridges
-    plain = np.asarray(field_of(ridged_terrain, ReachabilityConfig(), require_spawn=True).spawn_xy)
+    plain = np.asarray(field_of(ridged_terrain, PLAIN, require_spawn=True).spawn_xy)
     assert np.any(plain[:, 0] > 2.2)  # which the plain condition accepts
     for xy in spawn[:: max(len(spawn) // 50, 1)]:
         for yaw in np.linspace(-math.pi, math.pi, 8, endpoint=False):
@@ -194,9 +208,9 @@ center = [3.0, 2.0, -0.1]
 size = [2.0, 1.0, 0.2]
 """)
     poses = rc.sample_poses(terrain, 400, seed=3)
-    for reach in (ReachabilityConfig(leg_forward=0.15),
-                  ReachabilityConfig(foothold_radius=0.065, foothold_search=0.10, foothold_spread=0.02),
-                  ReachabilityConfig(leg_forward=0.1, foothold_spread=0.01, trunk_radius=0.2)):
+    for reach in (plain_with(leg_forward=0.15),
+                  plain_with(foothold_radius=0.065, foothold_search=0.10, foothold_spread=0.02),
+                  plain_with(leg_forward=0.1, foothold_spread=0.01, trunk_radius=0.2)):
         jitted = rc.condition(terrain, poses, reach)
         foothold = None if reach.foothold_spread is None else (reach.foothold_radius, reach.foothold_search)
         samples = rc.raster_samples(terrain, poses, reach.trunk_radius, reach.leg_radius, reach.leg_lateral_offset,
@@ -204,7 +218,7 @@ size = [2.0, 1.0, 0.2]
         numpy = rc.thresholds(samples, reach.trunk_bottom, reach.leg_bottom, reach.leg_top, reach.foothold_spread)
         np.testing.assert_array_equal(numpy, jitted)
         # the term matters on these poses: it rejects some that the plain condition accepts
-        assert np.sum(rc.condition(terrain, poses, ReachabilityConfig()) & ~jitted) > 0
+        assert np.sum(rc.condition(terrain, poses, PLAIN) & ~jitted) > 0
 
 
 def test_default_spawn_points_are_valid_for_every_yaw():
@@ -237,12 +251,11 @@ def test_hands_term_rejects_a_wall_beside_the_grippers_only(wall_terrain):
     0.13 m) reaches y + 0.58. The trunk (0.30 m) alone accepts the root 0.35 m from the
     wall; the hands term rejects it there, accepts it 0.65 m away, and turning the root
     to face the wall (hands along the face, 0.12 m ahead) accepts it at 0.35 m again."""
-    reach = ReachabilityConfig(hand_radius=0.13)
-    assert ReachabilityConfig().hand_radius is None
+    reach = plain_with(hand_radius=0.13)
     field = field_of(wall_terrain, reach)
     assert field.hand_max.shape == field.heights.shape
     near, far = pose(2.0, 2.15), pose(2.0, 1.85)
-    assert valid(field, near, ReachabilityConfig())  # the default condition has no hands
+    assert valid(field, near, PLAIN)  # the cylinders alone have no hands
     t = reachability.terms(field, near, reach)
     assert not bool(t["left_hand_free"]) and bool(t["right_hand_free"]) and bool(t["trunk_free"])
     assert not valid(field, near, reach)
@@ -254,13 +267,13 @@ def test_hands_term_rejects_a_wall_beside_the_grippers_only(wall_terrain):
 
 
 def test_hands_term_needs_its_raster(wall_terrain):
-    field = field_of(wall_terrain, ReachabilityConfig())
+    field = field_of(wall_terrain, PLAIN)
     with pytest.raises(ValueError, match="hand raster"):
-        reachability.terms(field, pose(2.0, 1.0), ReachabilityConfig(hand_radius=0.13))
+        reachability.terms(field, pose(2.0, 1.0), plain_with(hand_radius=0.13))
 
 
 def test_hands_term_spawn_points_keep_every_yaw_clear(wall_terrain):
-    reach = ReachabilityConfig(hand_radius=0.13)
+    reach = plain_with(hand_radius=0.13)
     field = field_of(wall_terrain, reach, require_spawn=True)
     spawn = np.asarray(field.spawn_xy)
     below = spawn[spawn[:, 1] < 2.5]  # the wall's top, 1.5 m wide, is ground too

@@ -10,7 +10,7 @@ import pytest
 from leas_jax.env import EnvConfig, heightfield_from_raster
 from leas_jax.errors import LeasError, UsageError
 from leas_jax.training import TrainConfig, load_policy, preset, train
-from leas_jax.training.config import pretraining_config
+from leas_jax.training.config import TRAINING_ENV, TRAINING_REACHABILITY, pretraining_config
 from leas_jax.training import checkpoint
 
 
@@ -32,7 +32,10 @@ def test_presets_and_validation():
     assert preset("paper").num_timesteps == 80_000_000
     assert preset("quick").hidden_sizes == (64, 64)
     # the paper's five reward terms in `paper`; `quick` adds clearance, in both phases and its pretraining
-    assert preset("paper").env.rewards.clearance == 0.0 and preset("paper", mode="planner").env == EnvConfig()
+    assert preset("paper").env.rewards.clearance == 0.0 and preset("paper", mode="planner").env == TRAINING_ENV
+    # every preset trains with the looser TRAINING_REACHABILITY, not the calibrated default
+    assert TRAINING_ENV.reachability == TRAINING_REACHABILITY != EnvConfig().reachability
+    assert all(preset(name).env.reachability == TRAINING_REACHABILITY for name in ("smoke", "quick", "paper"))
     quick_planner = preset("quick", mode="planner")
     assert preset("quick").env.rewards.clearance > 0.0
     assert quick_planner.env == preset("quick").env == pretraining_config(quick_planner).env
@@ -46,6 +49,16 @@ def test_presets_and_validation():
     assert TrainConfig.from_dict(json.loads(config.to_json())) == config
     with pytest.raises(UsageError, match="unknown TrainConfig keys: bogus"):
         TrainConfig.from_dict({**config.to_dict(), "bogus": 1})
+    # a run saved before the optional terms existed loads with them off, whatever the defaults
+    calibrated = preset("paper", env=EnvConfig())
+    old = calibrated.to_dict()
+    for key in ("leg_forward", "foothold_radius", "foothold_search", "foothold_spread", "hand_radius",
+                "hand_forward", "hand_lateral", "hand_bottom"):
+        del old["env"]["reachability"][key]
+    loaded = TrainConfig.from_dict(old).env.reachability
+    assert loaded.leg_forward == 0.0 and loaded.hand_radius is None and loaded.foothold_spread is None
+    assert loaded.trunk_bottom == calibrated.env.reachability.trunk_bottom
+    assert TrainConfig.from_dict(calibrated.to_dict()) == calibrated  # a saved key wins
 
 
 def test_atomic_write_leaves_no_temporary_files(tmp_path):

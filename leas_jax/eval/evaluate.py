@@ -184,7 +184,8 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
     target = np.asarray(scenario.target, np.float64)
     trajectories, seconds = [], {m: 0.0 for m in methods}
     for k, cell in enumerate(cells):
-        starts = draw_starts(scenario, cell, n_starts, scenario.seed + k, field, config.nominal_root_height)
+        starts = draw_starts(scenario, cell, n_starts, scenario.seed + k, field, config.nominal_root_height,
+                             env.reachability)
 
         def add(method, guides, waypoints=None, errors=None):
             for n in range(len(starts.poses)):

@@ -41,7 +41,7 @@ REPO_ROOT = Path(__file__).resolve().parents[2]
 # `quick` seeds against 0-43.3 %: its lookahead legs must be on the 0.30 m beam 0.30 m before
 # the root is), a `paper` run with it fell behind the shipped pretrain everywhere but the
 # hole, and their arena episodes end 2-3 times as often, mostly on the hands term, whose
-# disks lie beyond the heightmap's +-0.45 m (so `make run`'s >= 90 % arena target fails).
+# disks lie beyond the heightmap's +-0.45 m (so `make run`'s >= 90 % arena target would fail).
 # README, "Contact generator", gives the figures. The planner-in-the-loop phase catches
 # what this looser condition lets through.
 REACHABILITY_TERMS_OFF = dict(leg_forward=0.0, foothold_spread=None, hand_radius=None)

@@ -62,6 +62,21 @@ def test_rollout_rejects_a_start_outside_the_terrain(run_dir, tmp_path, capsys):
     assert code == 2 and "outside the terrain bounds" in capsys.readouterr().err
 
 
+def test_train_with_the_calibrated_reachability_condition(tmp_path, capsys):
+    """`--reachability calibrated` trains with ReachabilityConfig() (both phases); the default
+    keeps the presets' TRAINING_REACHABILITY, and the choice is saved in config.json."""
+    from leas_jax.env import ReachabilityConfig
+    from leas_jax.training import load_policy
+    from leas_jax.training.config import TRAINING_REACHABILITY
+
+    small = ["--preset", "smoke", "--timesteps", "4096", "--num-envs", "64", "--no-progress"]
+    assert main(["train", *small, "--reachability", "calibrated", "--out", str(tmp_path / "c")]) == 0
+    assert main(["train", *small, "--out", str(tmp_path / "p")]) == 0
+    assert load_policy(tmp_path / "c").config.env.reachability == ReachabilityConfig()
+    assert load_policy(tmp_path / "p").config.env.reachability == TRAINING_REACHABILITY
+    assert "trained" in capsys.readouterr().out
+
+
 def test_console_script_runs():
     """The installed `leas` entry point answers --help without importing JAX errors."""
     result = subprocess.run([sys.executable, "-m", "leas_jax.cli", "--help"], capture_output=True, text=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 
 from leas_jax.errors import UsageError
@@ -43,6 +44,11 @@ def _add_training_arguments(parser) -> None:
                         help="training terrain (default terrains/training_arena.toml)")
     parser.add_argument("--timesteps", type=_positive_int, default=None, help="override the preset's env steps")
     parser.add_argument("--num-envs", type=_positive_int, default=None, help="override the number of parallel envs")
+    parser.add_argument("--reachability", choices=["presets", "calibrated"], default="presets",
+                        help="condition the policy trains with (both phases): presets (the default: "
+                             "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
+                             "lookahead legs and gripper disks, 95.4 / 90.6 %% sensitivity / specificity "
+                             "against the walking generator; the README's \"Contact generator\" gives the trade)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -69,7 +75,12 @@ def config_from_args(args):
         overrides["num_timesteps"] = args.timesteps
     if args.num_envs is not None:
         overrides["num_envs"] = args.num_envs
-    return preset(args.preset, mode=args.mode, **overrides)
+    config = preset(args.preset, mode=args.mode, **overrides)
+    if args.reachability == "calibrated":
+        from leas_jax.env import ReachabilityConfig
+
+        config = dataclasses.replace(config, env=dataclasses.replace(config.env, reachability=ReachabilityConfig()))
+    return config
 
 
 def cmd_train(args) -> int:
@@ -96,7 +107,7 @@ def cmd_run(args) -> int:
     train(geometric, out / "geometric", progress=not args.no_progress)
     if args.planner_steps > 0:
         overrides = {"num_timesteps": args.planner_steps, "init_from": str(out / "geometric"),
-                     "terrain": geometric.terrain, "seed": geometric.seed}
+                     "terrain": geometric.terrain, "seed": geometric.seed, "env": geometric.env}
         train(preset(args.preset, mode="planner", **overrides), out / "planner", progress=not args.no_progress,
               workers=args.workers, address=args.ray_address)
     workers = 2 if args.workers is None else args.workers

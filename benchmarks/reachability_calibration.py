@@ -517,7 +517,7 @@ def main(argv=None) -> None:
     from common import save
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import TRAINING_REACHABILITY
+    from leas_jax.training.config import REACHABILITY_TERMS_OFF, TRAINING_REACHABILITY
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--poses", type=int, default=12000)
@@ -535,13 +535,12 @@ def main(argv=None) -> None:
 
     terrain = load_terrain(args.terrain)
     # DESIGN §5 values: the defaults before this calibration.
-    no_terms = dict(leg_forward=0.0, foothold_spread=None, hand_radius=None)
     old = ReachabilityConfig(trunk_radius=0.30, trunk_bottom=-0.63, trunk_top=0.60, leg_radius=0.25,
-                             leg_lateral_offset=0.085, leg_bottom=-1.06, leg_top=-0.54, **no_terms)
+                             leg_lateral_offset=0.085, leg_bottom=-1.06, leg_top=-0.54, **REACHABILITY_TERMS_OFF)
     if args.baseline:
         tr, tb, tt, lr, lb, lt = map(float, args.baseline.split(","))
         old = ReachabilityConfig(trunk_radius=tr, trunk_bottom=tb, trunk_top=tt, leg_radius=lr, leg_bottom=lb,
-                                 leg_top=lt, **no_terms)
+                                 leg_top=lt, **REACHABILITY_TERMS_OFF)
     poses = sample_poses(terrain, args.poses, args.seed)
     suffix = "" if args.truth == "static" else f"_{args.truth}"
     truth, gt_seconds = cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse)

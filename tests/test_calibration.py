@@ -19,6 +19,7 @@ from leas_jax.contacts.generator import ContactPosture, double_support_posture
 from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT
 from leas_jax.env import ReachabilityConfig
 from leas_jax.terrain import loads_terrain
+from leas_jax.training.config import REACHABILITY_TERMS_OFF
 
 # Imported by name from benchmarks/ (on sys.path, which spawned pool workers inherit) so
 # that the pool can pickle its functions.
@@ -167,7 +168,7 @@ def test_hands_term_catches_grippers_beside_the_wall():
     poses = np.concatenate([POSES[:16], side])
     truth = rc.ground_truth(TERRAIN, poses, workers=1)
     assert truth[:16].all() and not truth[16:].any()
-    base = ReachabilityConfig(leg_forward=0.0, hand_radius=None)  # the default cylinders alone
+    base = ReachabilityConfig(**REACHABILITY_TERMS_OFF)  # the default cylinders alone
     assert rc.condition(TERRAIN, poses, base).all()  # every pose passes without the hands
     hands = dataclasses.replace(base, hand_radius=0.13)
     predicted = rc.condition(TERRAIN, poses, hands)

@@ -22,11 +22,12 @@ import pytest
 from leas_jax.env import EnvConfig, ReachabilityConfig, heightfield_from_raster
 from leas_jax.env import reachability
 from leas_jax.env.field import foothold_raster
+from leas_jax.training.config import REACHABILITY_TERMS_OFF
 
 RES = 0.02
 VOID = -2.0
 SIZE = 201  # cells per side: 4 m
-PLAIN = ReachabilityConfig(leg_forward=0.0, foothold_spread=None, hand_radius=None)  # cylinders only
+PLAIN = ReachabilityConfig(**REACHABILITY_TERMS_OFF)  # the default cylinders only
 
 
 def plain_with(**terms) -> ReachabilityConfig:

@@ -10,6 +10,10 @@ controller" (HPP's kinodynamic planner, Fernbach et al. 2017). This one:
   growing forward in time, one from the goal state (at rest) growing backward
   (its edges are RBKino paths *into* its nodes); they swap roles every
   iteration (RRT-Connect);
+* samples: half uniform (a valid position, a velocity in any direction), half
+  from the bridge test (Hsu et al. 2003), midpoints between two invalid
+  positions, with a velocity along the passage: narrow passages such as the
+  0.30 m bridge, under 1 % of the valid area, get a share of the samples;
 * nearest neighbour by RBKino's minimum time (HPP's kinodynamic distance);
 * a local path is valid when every pose on it, one every timestep, satisfies
   the reachability condition of the LeaS environment (`reachability.valid`,
@@ -58,6 +62,13 @@ class RRTConfig:
     # s: an extension keeps at most this much of its local path (the RRT step size);
     # short steps put more nodes, with fresh velocities, into narrow passages (the bridge)
     max_extension_seconds: float = 3.0
+    # Narrow passages (the 0.30 m bridge: its valid strip is 0.2 m wide and 3 m long, under 1 %
+    # of the valid area). This share of the samples comes from the bridge test (Hsu et al.,
+    # ICRA 2003): two invalid positions `bridge_length` apart (uniform in the range) whose
+    # midpoint is valid; the sample is that midpoint, its velocity along the passage (across
+    # the segment). 0 disables it (uniform sampling only).
+    bridge_fraction: float = 0.5
+    bridge_length: tuple[float, float] = (0.3, 0.8)  # m
     shortcut: bool = True  # greedy shortening of the node sequence
     seed: int = 0
 
@@ -132,6 +143,12 @@ class _Problem:
                              self.reach)
         return bool(ok[0])
 
+    def valid_positions(self, xy: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+        """[K] validity of positions xy [K, 2] at yaws [M] (M divides K: the yaws repeat, in order)."""
+        yaws = np.tile(yaw, len(xy) // len(yaw))
+        _, ok = lift_checked(self.field, np.column_stack([xy, yaws]), self.config.nominal_root_height, self.reach)
+        return np.asarray(ok, bool)
+
 
 def _initial_heading(velocity: np.ndarray) -> float:
     """Direction of the first non-zero velocity (0 if the path never moves)."""
@@ -153,9 +170,15 @@ def _nearest(tree: _Tree, target: np.ndarray, config: BaselineConfig) -> int:
 
 
 def _sample(rng: np.random.Generator, bounds: np.ndarray, rrt: RRTConfig, problem: _Problem) -> np.ndarray:
-    """Random state: valid position inside the bounds, velocity of norm <= sample_speed."""
+    """Random state (x, y, vx, vy): from the bridge test with probability `bridge_fraction`, else
+    a valid position uniform inside the bounds with a velocity of norm <= sample_speed in any
+    direction. Falls back to the uniform draw when the bridge test finds no passage."""
     lo = bounds[0] + rrt.sample_margin
     hi = bounds[1] - rrt.sample_margin
+    if rrt.bridge_fraction > 0.0 and rng.random() < rrt.bridge_fraction:
+        state = _bridge_sample(rng, lo, hi, rrt, problem)
+        if state is not None:
+            return state
     state = None
     for _ in range(rrt.sample_attempts):
         xy = rng.uniform(lo, hi)
@@ -165,6 +188,31 @@ def _sample(rng: np.random.Generator, bounds: np.ndarray, rrt: RRTConfig, proble
         if problem.valid_state(state):
             return state
     return state
+
+
+def _bridge_sample(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, rrt: RRTConfig,
+                   problem: _Problem) -> np.ndarray | None:
+    """Bridge test over `sample_attempts` draws at once: an invalid position p, another one q at
+    a distance uniform in `bridge_length` in a uniform direction, and their midpoint valid.
+
+    Every pose is checked heading along the passage, the direction across p -> q, in which the
+    sampled velocity (norm uniform in [0, sample_speed], either way) points. Returns the state
+    [4] at the midpoint of the first draw that passes, or None.
+    """
+    n = rrt.sample_attempts
+    p = rng.uniform(lo, hi, (n, 2))
+    across = rng.uniform(-math.pi, math.pi, n)
+    q = p + rng.uniform(*rrt.bridge_length, n)[:, None] * np.column_stack([np.cos(across), np.sin(across)])
+    middle = (p + q) / 2.0
+    speed = rng.uniform(0.0, rrt.sample_speed, n) * np.where(rng.random(n) < 0.5, 1.0, -1.0)
+    along = speed[:, None] * np.column_stack([-np.sin(across), np.cos(across)])
+    valid = problem.valid_positions(np.concatenate([p, q, middle]), np.arctan2(along[:, 1], along[:, 0]))
+    inside = np.all((middle >= lo) & (middle <= hi), axis=1)
+    passes = np.flatnonzero(~valid[:n] & ~valid[n:2 * n] & valid[2 * n:] & inside)
+    if len(passes) == 0:
+        return None
+    k = passes[0]
+    return np.concatenate([middle[k], along[k]])
 
 
 def _extend(tree: _Tree, target: np.ndarray, problem: _Problem, rrt: RRTConfig) -> int | None:
@@ -191,13 +239,17 @@ def _extend(tree: _Tree, target: np.ndarray, problem: _Problem, rrt: RRTConfig) 
 
 def _connect(new: int, tree: _Tree, other: _Tree, problem: _Problem) -> int | None:
     """Try one valid RBKino path from node `new` of `tree` to the nearest node of `other`."""
-    state = tree.states[new]
-    near = _nearest(other, state, problem.config)
+    near = _nearest(other, tree.states[new], problem.config)
+    return near if _joins(tree, new, other, near, problem) else None
+
+
+def _joins(tree: _Tree, a: int, other: _Tree, b: int, problem: _Problem) -> bool:
+    """Whether one valid RBKino path joins node `a` of `tree` and node `b` of `other` (in time order)."""
     if tree.forward:
-        _, _, ok, _ = problem.local_path(state, other.states[near], tree.yaws[new])
+        _, _, ok, _ = problem.local_path(tree.states[a], other.states[b], tree.yaws[a])
     else:
-        _, _, ok, _ = problem.local_path(other.states[near], state, other.yaws[near])
-    return near if ok.all() else None
+        _, _, ok, _ = problem.local_path(other.states[b], tree.states[a], other.yaws[b])
+    return bool(ok.all())
 
 
 def _shortcut(states: list, yaw0: float, problem: _Problem) -> list:

@@ -239,17 +239,13 @@ def _extend(tree: _Tree, target: np.ndarray, problem: _Problem, rrt: RRTConfig) 
 
 def _connect(new: int, tree: _Tree, other: _Tree, problem: _Problem) -> int | None:
     """Try one valid RBKino path from node `new` of `tree` to the nearest node of `other`."""
-    near = _nearest(other, tree.states[new], problem.config)
-    return near if _joins(tree, new, other, near, problem) else None
-
-
-def _joins(tree: _Tree, a: int, other: _Tree, b: int, problem: _Problem) -> bool:
-    """Whether one valid RBKino path joins node `a` of `tree` and node `b` of `other` (in time order)."""
+    state = tree.states[new]
+    near = _nearest(other, state, problem.config)
     if tree.forward:
-        _, _, ok, _ = problem.local_path(tree.states[a], other.states[b], tree.yaws[a])
+        _, _, ok, _ = problem.local_path(state, other.states[near], tree.yaws[new])
     else:
-        _, _, ok, _ = problem.local_path(other.states[b], tree.states[a], other.yaws[b])
-    return bool(ok.all())
+        _, _, ok, _ = problem.local_path(other.states[near], state, other.yaws[near])
+    return near if ok.all() else None
 
 
 def _shortcut(states: list, yaw0: float, problem: _Problem) -> list:

@@ -137,17 +137,15 @@ class _Problem:
         guide, ok = lift_checked(self.field, np.column_stack([pos, yaw]), c.nominal_root_height, self.reach)
         return np.column_stack([pos, vel]), yaw, ok, guide
 
-    def valid_state(self, state) -> bool:
-        yaw = math.atan2(state[3], state[2])
-        _, ok = lift_checked(self.field, np.array([[state[0], state[1], yaw]]), self.config.nominal_root_height,
-                             self.reach)
-        return bool(ok[0])
-
     def valid_positions(self, xy: np.ndarray, yaw: np.ndarray) -> np.ndarray:
-        """[K] validity of positions xy [K, 2] at yaws [M] (M divides K: the yaws repeat, in order)."""
-        yaws = np.tile(yaw, len(xy) // len(yaw))
-        _, ok = lift_checked(self.field, np.column_stack([xy, yaws]), self.config.nominal_root_height, self.reach)
+        """[K] validity of root positions xy [K, 2] (world) heading yaw [K] (rad), one jitted check."""
+        _, ok = lift_checked(self.field, np.column_stack([xy, yaw]), self.config.nominal_root_height, self.reach)
         return np.asarray(ok, bool)
+
+    def valid_state(self, state) -> bool:
+        """Validity of a state (x, y, vx, vy) heading along its velocity."""
+        state = np.asarray(state, np.float64)
+        return bool(self.valid_positions(state[None, :2], np.array([math.atan2(state[3], state[2])]))[0])
 
 
 def _initial_heading(velocity: np.ndarray) -> float:
@@ -206,7 +204,8 @@ def _bridge_sample(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, rrt
     middle = (p + q) / 2.0
     speed = rng.uniform(0.0, rrt.sample_speed, n) * np.where(rng.random(n) < 0.5, 1.0, -1.0)
     along = speed[:, None] * np.column_stack([-np.sin(across), np.cos(across)])
-    valid = problem.valid_positions(np.concatenate([p, q, middle]), np.arctan2(along[:, 1], along[:, 0]))
+    heading = np.arctan2(along[:, 1], along[:, 0])
+    valid = problem.valid_positions(np.concatenate([p, q, middle]), np.tile(heading, 3))
     inside = np.all((middle >= lo) & (middle <= hi), axis=1)
     passes = np.flatnonzero(~valid[:n] & ~valid[n:2 * n] & valid[2 * n:] & inside)
     if len(passes) == 0:

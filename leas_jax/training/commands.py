@@ -25,8 +25,8 @@ def _add_training_arguments(parser) -> None:
 
     parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
                         help="geometric: smoke (< 1 min), quick (80 M steps, 3 epochs, clearance reward term, "
-                             "~6 min on 2 cores), paper (80 M steps, 10 epochs, the paper's reward, ~25 min); planner: smoke (20 k kept steps from "
-                             "scratch), quick and paper (the geometric preset of the same name in "
+                             "~6 min on 2 cores), paper (80 M steps, 10 epochs, the paper's reward, ~25 min); "
+                             "planner: smoke (20 k kept steps from scratch), quick and paper (the geometric preset of the same name in "
                              "<out>/pretrain, then 150 k / 600 k kept steps with the planner)")
     parser.add_argument("--mode", default="geometric", choices=["geometric", "planner"],
                         help="geometric: reachability condition only; planner: every episode validated by the "

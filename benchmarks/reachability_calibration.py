@@ -225,18 +225,19 @@ def generator_fingerprint(truth: str) -> str:
     return digest.hexdigest()
 
 
-def cache_path(truth: str) -> Path:
-    """.cache/reachability_ground_truth[_<truth>].npz at the repository root (git-ignored)."""
-    suffix = "" if truth == "static" else f"_{truth}"
+def cache_path(truth: str, tag: str = "") -> Path:
+    """.cache/reachability_ground_truth[_<truth>][_<tag>].npz at the repository root (git-ignored);
+    `tag` names another pose set (benchmarks/reachability_validation.py)."""
+    suffix = ("" if truth == "static" else f"_{truth}") + (f"_{tag}" if tag else "")
     return REPO / ".cache" / f"reachability_ground_truth{suffix}.npz"
 
 
 def cached_ground_truth(terrain, poses: np.ndarray, truth: str = "static", workers: int = 2,
-                        reuse: bool = True) -> tuple[np.ndarray, float]:
-    """`ground_truth` of poses [N, 4], from the cache when `reuse` and it holds the same poses
-    and generator fingerprint; otherwise computed and cached. Returns (truth [N] bool,
-    seconds it took to compute)."""
-    cache = cache_path(truth)
+                        reuse: bool = True, tag: str = "") -> tuple[np.ndarray, float]:
+    """`ground_truth` of poses [N, 4], from the cache (`cache_path(truth, tag)`) when `reuse`
+    and it holds the same poses and generator fingerprint; otherwise computed and cached.
+    Returns (truth [N] bool, seconds it took to compute)."""
+    cache = cache_path(truth, tag)
     fingerprint = generator_fingerprint(truth)
     if reuse and cache.is_file():
         with np.load(cache) as data:

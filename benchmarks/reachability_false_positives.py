@@ -184,7 +184,7 @@ def main(argv=None) -> None:
     from leas_jax.terrain import load_terrain
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--poses", type=int, default=12000)
+    parser.add_argument("--poses", type=int, default=48000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--terrain", default=str(rc.ARENA))

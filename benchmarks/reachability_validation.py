@@ -1,8 +1,7 @@
 """Check the calibrated reachability condition on fresh poses, and how far a richer one could go.
 
-benchmarks/reachability_calibration.py fits the condition's parameters to 12 000 poses
-of terrains/training_arena.toml (seed 0) and reports them on a held-out third (about
-1 100 feasible poses under the walking truth: +-1.3 % on a sensitivity at 95 %). This
+benchmarks/reachability_calibration.py fits the condition's parameters to 48 000 poses
+of terrains/training_arena.toml (seed 0) and reports them on a held-out third. This
 script draws an independent set (`--poses`, default 36 000, `--seed`, default 1; same
 sampler, `reachability_calibration.sample_poses`), computes the contact generator's
 ground truth there (cached in .cache/ like the calibration's), and reports:
@@ -18,8 +17,8 @@ ground truth there (cached in .cache/ like the calibration's), and reports:
    tree ensemble (scikit-learn's HistGradientBoostingClassifier) is fitted on the fresh
    poses' root-frame heightmaps (`local_heightmap`: 26 x 33 points 0.04 m apart,
    x -0.40..+0.60 m, y -0.64..+0.64 m, terrain height minus root z) and tested on the
-   calibration's 12 000 poses. Its threshold is set on a tenth of the fitting poses kept
-   aside, for 95 % sensitivity there; the report gives the test figures at that
+   calibration's poses (`--calibration-poses`). Its threshold is set on a tenth of the
+   fitting poses kept aside, for 95 % sensitivity there; the report gives the test figures at that
    threshold, and the specificity at the threshold that gives exactly 95 % sensitivity
    on the test poses (optimistic: chosen on them). Repeated for growing training sets
    (`--train-sizes`): whether the cylinders' gap is one of information (the heightfield
@@ -176,7 +175,7 @@ def main(argv=None) -> None:
     parser.add_argument("--learned", action="store_true", help="fit the learned reference (scikit-learn)")
     parser.add_argument("--train-sizes", default="8000,18000,36000",
                         help="comma-separated training set sizes of the learned reference")
-    parser.add_argument("--calibration-poses", type=int, default=12000,
+    parser.add_argument("--calibration-poses", type=int, default=48000,
                         help="the calibration's pose count (seed 0): the learned reference's test set")
     args = parser.parse_args(argv)
     if args.seed == 0:

@@ -2,8 +2,8 @@
 the lookahead leg cylinders (`leg_forward`), the foothold flatness term
 (`foothold_radius`, `foothold_search`, `foothold_spread`) and the hands term
 (`hand_radius`, `hand_forward`, `hand_lateral`, `hand_bottom`). The calibrated default
-turns the lookahead and the hands on; each term is tested here added to PLAIN, the
-default cylinders alone.
+turns all three on; each term is tested here added to PLAIN, the default cylinders
+alone.
 
 Terrains are 4 x 4 m rasters (2 cm cells, void at -2 m, world origin at the raster's
 corner); roots stand 1.0 m above the ground, where the default condition holds.
@@ -69,15 +69,20 @@ def ridged_terrain():
     return heights
 
 
-def test_defaults_turn_on_the_lookahead_and_the_hands_only():
+def test_defaults_turn_on_every_optional_term(ridged_terrain):
     reach = ReachabilityConfig()
-    assert reach.leg_forward == 0.30 and reach.hand_radius == 0.13 and reach.foothold_spread is None
+    assert reach.leg_forward == 0.30 and reach.hand_radius == 0.13 and reach.foothold_spread == 0.04
     heights = np.zeros((SIZE, SIZE), np.float32)
     field = field_of(heights, reach, require_spawn=True)
-    assert field.foothold.shape == (1, 1)  # no raster when the term is off
+    assert field.foothold.shape == field.heights.shape
     assert field.hand_max.shape == field.heights.shape
     t = reachability.terms(field, pose(1.0, 1.0), reach)
     assert all(bool(v) for v in t.values())
+    # 5 cm ridges under every leg: the cylinders touch, the foothold term refuses
+    ridged = field_of(ridged_terrain, reach)
+    t = reachability.terms(ridged, pose(3.0, 2.0), reach)
+    assert bool(t["left_touch"]) and bool(t["right_touch"]) and bool(t["trunk_free"])
+    assert not bool(t["left_foothold"]) and not bool(t["right_foothold"])
     plain = field_of(heights, PLAIN)
     assert plain.hand_max.shape == (1, 1)
     t = reachability.terms(plain, pose(1.0, 1.0), PLAIN)

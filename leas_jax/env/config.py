@@ -17,28 +17,30 @@ class ReachabilityConfig:
     DESIGN.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
     Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]). The
     defaults below were calibrated by benchmarks/reachability_calibration.py against
-    the contact generator *walking* (`--truth walking`: a pose is feasible when the
-    generator covers a 0.36 m straight guide from it; 12 000 poses of
+    the contact generator *walking* (`--truth walking --poses 48000`: a pose is feasible
+    when the generator covers a 0.36 m straight guide from it; 48 000 poses of
     terrains/training_arena.toml). The static truth (one double-support posture, the
     issue's definition) lets the root down to about 0.5 m, where the generator does not walk.
 
-    Against the current generator these defaults give sensitivity 95.4 % and specificity
-    90.6 % on all 12 000 poses (95.8 / 90.2 % on the two thirds the search fits, 94.7 /
-    91.5 % on the held-out third). Cylinders alone cannot: their best at >= 95 %
-    sensitivity is 94.9 / 85.6 %. Two of the optional terms below close the gap and are on
-    by default: the lookahead legs 0.30 m ahead (ground where the next steps land) and the
-    hands (the half-sitting grippers beside the trunk cylinder). The foothold term stays
-    off. The previous defaults (trunk bottom -0.825, leg top -0.55, no terms) gave
-    79.5 / 89.2 %. The README's "Contact generator" section has the figures and their
-    history.
+    Against the current generator these defaults give sensitivity 95.7 % and specificity
+    90.0 % on the 48 000 poses (95.7 / 90.0 % on the two thirds the search fits, 95.6 /
+    90.1 % on the held-out third) and 95.5 / 90.2 % on 36 000 fresh poses
+    (benchmarks/reachability_validation.py, seed 1). Cylinders alone cannot: their best
+    at >= 95 % sensitivity is 95.4 / 84.8 %. The three optional terms below close the gap
+    and are on by default: the lookahead legs 0.30 m ahead (ground where the next steps
+    land), the foothold (a sole-sized disk of even ground near each leg) and the hands
+    (the half-sitting grippers beside the trunk cylinder). The previous defaults
+    (calibrated on 12 000 poses: trunk bottom -0.70, no foothold term) gave 95.1 / 90.7 %
+    on the 48 000 poses and 94.9 / 90.9 % on the fresh ones. The README's "Contact
+    generator" section has the figures and their history.
     """
 
     # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)
     trunk_radius: float = 0.30
-    # m below the root: calibrated; the root stays 0.70 m above everything within
-    # trunk_radius (DESIGN §5: -0.63, the hip; static calibration: -0.525); leg_top keeps it
-    # 0.75 m above the ground under the legs
-    trunk_bottom: float = -0.70
+    # m below the root: calibrated; the root stays 0.475 m above everything within
+    # trunk_radius (DESIGN §5: -0.63, the hip; -0.70 in the 12 000-pose calibration); leg_top
+    # keeps it 0.75 m above the ground under the legs, the hands term clear beside it
+    trunk_bottom: float = -0.475
     trunk_top: float = 0.60  # m above the root: head (no effect on a heightfield, which has no overhangs)
     # m, radius of each leg cylinder: calibrated (DESIGN §5: 0.25, talos_*leg_rom); the generator
     # needs ground near the nominal sole place, so a wide disk over-accepts
@@ -49,7 +51,7 @@ class ReachabilityConfig:
     leg_bottom: float = -1.175
     leg_top: float = -0.75  # m below the root: highest reachable sole height, calibrated (DESIGN §5: -0.54)
     # Optional terms (benchmarks/reachability_false_positives.py, issue 3 item 6). The
-    # calibration turns the lookahead and the hands on; the foothold term is off.
+    # calibration turns all three on.
     # m, lookahead: a second pair of leg cylinders at (leg_forward, ±leg_lateral_offset) in the
     # root frame (same radius and band) must touch too: ground where the next steps land.
     # 0 disables it. Calibrated: 0.30 m (the walking truth covers a 0.36 m guide).
@@ -61,7 +63,9 @@ class ReachabilityConfig:
     foothold_search: float = 0.10
     # m, foothold: each leg needs, within foothold_search of its centre, a sole disk of radius
     # foothold_radius over solid terrain (no void) whose heights span at most this. None disables it.
-    foothold_spread: float | None = None
+    # Calibrated: 0.04 m (a 10-degree slope spans 0.03 m over the disk; rubble and stair
+    # edges more).
+    foothold_spread: float | None = 0.04
     # Hands: the Talos model keeps its arms at the half-sitting posture, where the grippers
     # reach 0.55 m sideways from the root, 0.04-0.21 m ahead of it and down to 0.39 m below it
     # (measured on the model's collision geometry), outside the trunk cylinder: guides

@@ -47,8 +47,9 @@ def _add_training_arguments(parser) -> None:
     parser.add_argument("--reachability", choices=["presets", "calibrated"], default="presets",
                         help="condition the policy trains with (both phases): presets (the default: "
                              "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
-                             "lookahead legs and gripper disks, 95.4 / 90.6 %% sensitivity / specificity "
-                             "against the walking generator; the README's \"Contact generator\" gives the trade)")
+                             "lookahead legs, foothold and gripper disks, 95.5 / 90.2 %% sensitivity / specificity "
+                             "against the walking generator on fresh poses; the README's \"Contact generator\" "
+                             "gives the trade)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 

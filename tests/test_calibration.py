@@ -18,7 +18,7 @@ import pytest
 from leas_jax.contacts.generator import ContactPosture, double_support_posture
 from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT
 from leas_jax.env import ReachabilityConfig
-from leas_jax.terrain import loads_terrain
+from leas_jax.terrain import load_terrain
 from leas_jax.training.config import REACHABILITY_TERMS_OFF
 
 # Imported by name from benchmarks/ (on sys.path, which spawned pool workers inherit) so
@@ -26,17 +26,7 @@ from leas_jax.training.config import REACHABILITY_TERMS_OFF
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 import reachability_calibration as rc  # noqa: E402
 
-TERRAIN = loads_terrain("""name = "calibration_cases"
-bounds = [[0.0, 0.0], [6.0, 6.0]]
-void_height = -2.0
-resolution = 0.02
-[[box]]
-center = [3.0, 3.0, -0.1]
-size = [6.0, 6.0, 0.2]
-[[box]]
-center = [4.5, 3.0, 0.75]
-size = [0.4, 4.0, 1.5]
-""")  # wall: x 4.3-4.7, y 1-5, 1.5 m tall
+TERRAIN = load_terrain(Path(__file__).parent / "data" / "slab_with_wall.toml")  # wall: x 4.3-4.7, y 1-5
 
 
 def _cases():

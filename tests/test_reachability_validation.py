@@ -9,24 +9,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from leas_jax.terrain import loads_terrain
+from leas_jax.terrain import load_terrain
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 import common  # noqa: E402
 import reachability_calibration as rc  # noqa: E402
 import reachability_validation as rv  # noqa: E402
 
-WALL = loads_terrain("""name = "validation_wall"
-bounds = [[0.0, 0.0], [6.0, 6.0]]
-void_height = -2.0
-resolution = 0.02
-[[box]]
-center = [3.0, 3.0, -0.1]
-size = [6.0, 6.0, 0.2]
-[[box]]
-center = [4.5, 3.0, 0.75]
-size = [0.4, 4.0, 1.5]
-""")  # ground at 0, wall x 4.3-4.7, y 1-5, 1.5 m tall
+WALL = load_terrain(Path(__file__).parent / "data" / "slab_with_wall.toml")  # ground at 0, wall x 4.3-4.7, y 1-5
 
 
 def test_wilson_interval_by_hand():

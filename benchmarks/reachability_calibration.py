@@ -44,9 +44,10 @@ among those with sensitivity >= 95 % and specificity >= 90 % on the fitting two
 thirds of the poses, the largest Youden index (sensitivity + specificity - 1); if none
 meets both, the best specificity among those with sensitivity >= 95 %; if none, the
 largest Youden index. Near-ties go to the closest to the old defaults. Figures are
-reported on the held-out third and on all poses. Writes results/reachability_calibration.json (and caches the ground truth in
-.cache/reachability_ground_truth[_walking].npz at the repository root, reused with --reuse when the
-poses and the fingerprint of the contact generator's sources, leas_jax/contacts/*.py, match).
+reported on the held-out third and on all poses. Writes results/reachability_calibration.json
+(and caches the ground truth in .cache/reachability_ground_truth_<truth>_seed<seed>_<poses>.npz
+at the repository root, reused with --reuse when the poses and the fingerprint of the
+contact generator's sources, leas_jax/contacts/*.py, match).
 
 Default: 48 000 poses (the walking truth's held-out third then holds ~4 400 feasible
 poses, +-0.6 % on a sensitivity at 95 %; with the 12 000 used until the eleventh session,
@@ -230,19 +231,20 @@ def generator_fingerprint(truth: str) -> str:
     return digest.hexdigest()
 
 
-def cache_path(truth: str, tag: str = "") -> Path:
-    """.cache/reachability_ground_truth[_<truth>][_<tag>].npz at the repository root (git-ignored);
-    `tag` names another pose set (benchmarks/reachability_validation.py)."""
-    suffix = ("" if truth == "static" else f"_{truth}") + (f"_{tag}" if tag else "")
-    return REPO / ".cache" / f"reachability_ground_truth{suffix}.npz"
+def cache_path(truth: str, seed: int, count: int) -> Path:
+    """.cache/reachability_ground_truth_<truth>_seed<seed>_<count>.npz at the repository root
+    (git-ignored): one file per pose set (`sample_poses(terrain, count, seed)`), so that
+    runs on other sets (benchmarks/reachability_validation.py) keep each other's."""
+    return REPO / ".cache" / f"reachability_ground_truth_{truth}_seed{seed}_{count}.npz"
 
 
 def cached_ground_truth(terrain, poses: np.ndarray, truth: str = "static", workers: int = 2,
-                        reuse: bool = True, tag: str = "") -> tuple[np.ndarray, float]:
-    """`ground_truth` of poses [N, 4], from the cache (`cache_path(truth, tag)`) when `reuse`
-    and it holds the same poses and generator fingerprint; otherwise computed and cached.
-    Returns (truth [N] bool, seconds it took to compute)."""
-    cache = cache_path(truth, tag)
+                        reuse: bool = True, seed: int = 0) -> tuple[np.ndarray, float]:
+    """`ground_truth` of poses [N, 4] (drawn with `seed`), from the cache
+    (`cache_path(truth, seed, N)`) when `reuse` and it holds the same poses and generator
+    fingerprint; otherwise computed and cached. Returns (truth [N] bool, seconds it took
+    to compute)."""
+    cache = cache_path(truth, seed, len(poses))
     fingerprint = generator_fingerprint(truth)
     if reuse and cache.is_file():
         with np.load(cache) as data:
@@ -549,7 +551,7 @@ def main(argv=None) -> None:
                                  leg_top=lt, **REACHABILITY_TERMS_OFF)
     poses = sample_poses(terrain, args.poses, args.seed)
     suffix = "" if args.truth == "static" else f"_{args.truth}"
-    truth, gt_seconds = cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse)
+    truth, gt_seconds = cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse, args.seed)
     print(f"ground truth: {len(poses)} poses, {int(truth.sum())} feasible, {gt_seconds:.0f} s "
           f"with {args.workers} workers ({1e3 * gt_seconds * max(args.workers, 1) / len(poses):.1f} ms per pose "
           f"per worker)")

@@ -199,11 +199,10 @@ def main(argv=None) -> None:
             parser.error(f"--calibration-json {path}: cannot read its chosen_with_hands ({error})")
         configs[f"chosen_with_hands of {path.name}"] = ReachabilityConfig(**chosen)
     poses = rc.sample_poses(terrain, args.poses, args.seed)
-    tag = f"seed{args.seed}_{args.poses}"
     report = {"poses": args.poses, "seed": args.seed, "terrain": f"terrains/{rc.ARENA.name}",
               "configs": {name: dataclasses.asdict(cfg) for name, cfg in configs.items()}, "truths": {}}
     for truth_name in args.truth:
-        truth, seconds = rc.cached_ground_truth(terrain, poses, truth_name, args.workers, args.reuse, tag)
+        truth, seconds = rc.cached_ground_truth(terrain, poses, truth_name, args.workers, args.reuse, args.seed)
         print(f"\n{truth_name} truth: {len(poses)} fresh poses (seed {args.seed}), {int(truth.sum())} feasible, "
               f"{seconds:.0f} s with {args.workers} workers")
         entry = {"feasible": int(truth.sum()), "ground_truth_seconds": seconds, "validation": {}}
@@ -212,7 +211,7 @@ def main(argv=None) -> None:
             print(f"  {name:40s} {_fmt(entry['validation'][name])}")
         if args.learned:
             test_poses = rc.sample_poses(terrain, args.calibration_poses, 0)
-            test_truth, _ = rc.cached_ground_truth(terrain, test_poses, truth_name, args.workers, args.reuse)
+            test_truth, _ = rc.cached_ground_truth(terrain, test_poses, truth_name, args.workers, args.reuse, 0)
             order = np.random.default_rng(args.seed).permutation(len(poses))
             rows = learned_reference(local_heightmap(terrain, poses[order]), truth[order],
                                      local_heightmap(terrain, test_poses), test_truth, sizes)

@@ -78,7 +78,7 @@ def test_validation_end_to_end_on_fresh_arena_poses(tmp_path, monkeypatch):
     for figures in static["validation"].values():
         assert figures["tp"] + figures["fn"] == static["feasible"]
         assert figures["tp"] + figures["fn"] + figures["fp"] + figures["tn"] == 40
-    assert (tmp_path / ".cache" / "reachability_ground_truth_seed3_40.npz").is_file()
+    assert (tmp_path / ".cache" / "reachability_ground_truth_static_seed3_40.npz").is_file()
 
 
 def test_validation_refuses_the_calibration_seed_and_bad_json(tmp_path, capsys):

@@ -56,6 +56,7 @@ HEIGHTMAP_STEP = 0.04  # m, spacing of the learned reference's heightmap
 HEIGHTMAP_X = (-0.40, 0.60)  # m, root frame: behind the heels to past the lookahead legs (+0.30 m)
 HEIGHTMAP_Y = (-0.64, 0.64)  # m, root frame: past the hand disks (0.45 + 0.13 m)
 HEIGHTMAP_CLIP = (-1.6, 0.4)  # m, heights relative to the root (the void is -2 m below the arena)
+CALIBRATION_SEED = 0  # benchmarks/reachability_calibration.py's default --seed
 THRESHOLD_SPLIT = 0.1  # share of the fitting poses kept aside to set the classifier's threshold
 
 
@@ -178,7 +179,7 @@ def main(argv=None) -> None:
     parser.add_argument("--calibration-poses", type=int, default=48000,
                         help="the calibration's pose count (seed 0): the learned reference's test set")
     args = parser.parse_args(argv)
-    if args.seed == 0:
+    if args.seed == CALIBRATION_SEED:
         parser.error("--seed 0 draws the calibration's own poses; validate on another seed")
     sizes = [int(s) for s in args.train_sizes.split(",")] if args.learned else []
     if args.learned:
@@ -199,6 +200,11 @@ def main(argv=None) -> None:
             parser.error(f"--calibration-json {path}: cannot read its chosen_with_hands ({error})")
         configs[f"chosen_with_hands of {path.name}"] = ReachabilityConfig(**chosen)
     poses = rc.sample_poses(terrain, args.poses, args.seed)
+    if args.learned:  # the same features for every truth: the fresh poses (shuffled) and the calibration's
+        order = np.random.default_rng(args.seed).permutation(len(poses))
+        train_x = local_heightmap(terrain, poses[order])
+        test_poses = rc.sample_poses(terrain, args.calibration_poses, CALIBRATION_SEED)
+        test_x = local_heightmap(terrain, test_poses)
     report = {"poses": args.poses, "seed": args.seed, "terrain": f"terrains/{rc.ARENA.name}",
               "configs": {name: dataclasses.asdict(cfg) for name, cfg in configs.items()}, "truths": {}}
     for truth_name in args.truth:
@@ -210,12 +216,11 @@ def main(argv=None) -> None:
             entry["validation"][name] = rates(rc.condition(terrain, poses, cfg), truth)
             print(f"  {name:40s} {_fmt(entry['validation'][name])}")
         if args.learned:
-            test_poses = rc.sample_poses(terrain, args.calibration_poses, 0)
-            test_truth, _ = rc.cached_ground_truth(terrain, test_poses, truth_name, args.workers, args.reuse, 0)
-            order = np.random.default_rng(args.seed).permutation(len(poses))
-            rows = learned_reference(local_heightmap(terrain, poses[order]), truth[order],
-                                     local_heightmap(terrain, test_poses), test_truth, sizes)
-            entry["learned_reference"] = {"test": f"the calibration's {len(test_poses)} poses (seed 0)",
+            test_truth, _ = rc.cached_ground_truth(terrain, test_poses, truth_name, args.workers, args.reuse,
+                                                   CALIBRATION_SEED)
+            rows = learned_reference(train_x, truth[order], test_x, test_truth, sizes)
+            test_set = f"the calibration's {len(test_poses)} poses (seed {CALIBRATION_SEED})"
+            entry["learned_reference"] = {"test": test_set,
                                           "heightmap": {"step_m": HEIGHTMAP_STEP, "x_m": HEIGHTMAP_X,
                                                         "y_m": HEIGHTMAP_Y, "clip_m": HEIGHTMAP_CLIP},
                                           "rows": rows}

@@ -22,9 +22,14 @@ size = [0.2, 2.6, 1.5]
 """
 
 
+def _terrain_and_field(text: str):
+    """A terrain from TOML text and its heightfield with the default EnvConfig."""
+    terrain = loads_terrain(text)
+    return terrain, heightfield_from_terrain(terrain, EnvConfig())
+
+
 def test_rrt_goes_around_a_wall_with_every_pose_valid():
-    terrain = loads_terrain(WALL)
-    field = heightfield_from_terrain(terrain, EnvConfig())
+    terrain, field = _terrain_and_field(WALL)
     start = np.array([1.0, 1.0, 1.0, 0.0])
     direct, ok = lift_checked(field, np.linspace([1.0, 1.0, 0.0], [5.0, 1.0, 0.0], 50), 1.0)
     assert not ok.all()  # the straight line is blocked
@@ -72,9 +77,8 @@ def test_bridge_test_samples_land_on_the_beam():
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.steering.rrt import _bridge_sample, _Problem, _sample
 
-    terrain = loads_terrain(BEAM)
+    terrain, field = _terrain_and_field(BEAM)
     env = EnvConfig()
-    field = heightfield_from_terrain(terrain, env)
     problem = _Problem(field, BaselineConfig.from_env(env), env.reachability)
     rrt = RRTConfig()
     rng = np.random.default_rng(0)
@@ -95,8 +99,7 @@ def test_bridge_test_samples_land_on_the_beam():
 
 
 def test_rrt_crosses_a_narrow_beam_with_every_pose_valid():
-    terrain = loads_terrain(BEAM)
-    field = heightfield_from_terrain(terrain, EnvConfig())
+    terrain, field = _terrain_and_field(BEAM)
     result = plan_rrt(field, np.array([1.0, 0.8, 1.0, 0.0]), [5.0, 2.2], 0.05, terrain.bounds,
                       rrt=RRTConfig(seed=0, max_iterations=3000, max_seconds=120.0))
     assert result.success, (result.iterations, result.tree_sizes)

@@ -14,8 +14,8 @@ A pose is valid when
     a vertical jump taller than the band (leg_top - leg_bottom) skips it
     entirely, e.g. a leg disk straddling a tall wall; the trunk test rejects
     most such poses.
-Three optional terms (the calibrated defaults of `ReachabilityConfig` turn on the
-lookahead and the hands; the training presets' `TRAINING_REACHABILITY` none; see
+Three optional terms (the calibrated defaults of `ReachabilityConfig` turn all three
+on; the training presets' `TRAINING_REACHABILITY` none; see
 benchmarks/reachability_false_positives.py for the false positives they target):
   - lookahead (`leg_forward` != 0): a second pair of leg cylinders centred at
     (leg_forward, ±leg_lateral_offset) in the root frame, same radius and band,

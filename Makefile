@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 RUN_NAME ?= quick
 JOBS ?= 2
 
-.PHONY: venv run test test-slow test-cluster bench clean
+.PHONY: venv run lint test test-slow test-cluster bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,7 +21,12 @@ venv: $(STAMP)
 run: $(STAMP)
 	$(VENV)/bin/leas run --preset quick --out runs/$(RUN_NAME)
 
-test: $(STAMP)
+# The linter and the formatter's check, as CI runs them (fix with `ruff check --fix . && ruff format .`).
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+
+test: lint
 	$(PY) -m pytest -q
 
 test-slow: $(STAMP)

@@ -24,9 +24,15 @@ def machine() -> dict:
     except OSError:
         pass
     device = jax.devices()[0]
-    return {"cpu": cpu, "cores": os.cpu_count(), "jax": jax.__version__, "backend": jax.default_backend(),
-            "device_kind": getattr(device, "device_kind", str(device)), "python": platform.python_version(),
-            "load_average_1min": os.getloadavg()[0]}
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "jax": jax.__version__,
+        "backend": jax.default_backend(),
+        "device_kind": getattr(device, "device_kind", str(device)),
+        "python": platform.python_version(),
+        "load_average_1min": os.getloadavg()[0],
+    }
 
 
 def save(name: str, payload: dict) -> Path:

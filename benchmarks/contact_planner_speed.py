@@ -40,8 +40,13 @@ from __future__ import annotations
 import os
 
 # One core: these must be set before NumPy / Pinocchio / coal load their thread pools.
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXPR_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS"):
+for _var in (
+    "OMP_NUM_THREADS",
+    "OPENBLAS_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "NUMEXPR_NUM_THREADS",
+    "VECLIB_MAXIMUM_THREADS",
+):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
@@ -54,14 +59,14 @@ from pathlib import Path  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-
 from common import save  # noqa: E402
+
 from leas_jax.contacts import NOMINAL_ROOT_HEIGHT, ContactGenerator, GeneratorConfig  # noqa: E402
 from leas_jax.terrain import loads_terrain  # noqa: E402
 
 DT = 0.1  # s, paper Table I
 SPEED = 0.18  # m/s, paper §IV
-OMEGA = math.pi / 9  # rad/s, omega_max (DESIGN §5)
+OMEGA = math.pi / 9  # rad/s, omega_max (docs/design.md §5)
 HEAD = 'name = "{name}"\nbounds = [[-2.0, -3.0], [7.0, 3.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
 PATH_TARGET_MS = 50.0
 STEP_TARGET_MS = 5.0
@@ -84,7 +89,9 @@ def flat_case():
     """4 m straight along +x on a flat slab; guide [223, 4]."""
     terrain = loads_terrain(HEAD.format(name="flat") + _box([2.5, 0, -0.1], [9, 6, 0.2]))
     x = np.linspace(0.0, 4.0, 1000)
-    guide = _resample(np.stack([x, np.zeros_like(x), np.full_like(x, NOMINAL_ROOT_HEIGHT), np.zeros_like(x)], 1))
+    guide = _resample(
+        np.stack([x, np.zeros_like(x), np.full_like(x, NOMINAL_ROOT_HEIGHT), np.zeros_like(x)], 1)
+    )
     return terrain, guide
 
 
@@ -125,7 +132,7 @@ PLAN_ARRAYS = ("q", "feet", "guide_index", "last_valid_index", "coverage")
 ARENA = Path(__file__).resolve().parent.parent / "terrains" / "training_arena.toml"
 ARENA_SEED = 0
 ARENA_MAX_SPEED = 0.3  # m/s, above the paper's 0.18 m/s (early-training policies)
-ARENA_MAX_YAW_RATE = math.pi / 9  # rad/s, omega_max (DESIGN §5)
+ARENA_MAX_YAW_RATE = math.pi / 9  # rad/s, omega_max (docs/design.md §5)
 
 
 def _arena_start(terrain, rng, pose_ok) -> np.ndarray:
@@ -168,7 +175,9 @@ def arena_guides(count: int = 24, seed: int = ARENA_SEED, length: int = 200, pos
             omega = rng.uniform(-ARENA_MAX_YAW_RATE, ARENA_MAX_YAW_RATE, length)
         else:
             speed = np.full(length, rng.uniform(0.1, ARENA_MAX_SPEED))
-            omega = np.full(length, 0.0 if k % 2 == 0 else rng.uniform(-ARENA_MAX_YAW_RATE, ARENA_MAX_YAW_RATE))
+            omega = np.full(
+                length, 0.0 if k % 2 == 0 else rng.uniform(-ARENA_MAX_YAW_RATE, ARENA_MAX_YAW_RATE)
+            )
         xyyaw = np.empty((length, 3))
         xyyaw[0] = start[[0, 1, 3]]
         for t in range(1, length):
@@ -197,12 +206,20 @@ def measure_arena(runs: int) -> dict:
     poses = sum(len(g) for g in guides)
     covered = sum(p.last_valid_index + 1 for p in plans)
     median = statistics.median(cpu)
-    return {"guides": len(guides), "guide_poses": poses, "covered_poses": covered,
-            "failed_guides": sum(p.last_valid_index < len(g) - 1 for p, g in zip(plans, guides)),
-            "mean_coverage": float(np.mean([p.coverage for p in plans])),
-            "best_s": min(cpu), "median_s": median, "wall_median_s": statistics.median(wall),
-            "poses_per_cpu_s_median": poses / median, "poses_per_cpu_s_best": poses / min(cpu),
-            "covered_poses_per_cpu_s_median": covered / median, "runs": runs}
+    return {
+        "guides": len(guides),
+        "guide_poses": poses,
+        "covered_poses": covered,
+        "failed_guides": sum(p.last_valid_index < len(g) - 1 for p, g in zip(plans, guides)),
+        "mean_coverage": float(np.mean([p.coverage for p in plans])),
+        "best_s": min(cpu),
+        "median_s": median,
+        "wall_median_s": statistics.median(wall),
+        "poses_per_cpu_s_median": poses / median,
+        "poses_per_cpu_s_best": poses / min(cpu),
+        "covered_poses_per_cpu_s_median": covered / median,
+        "runs": runs,
+    }
 
 
 def footsteps(plan) -> int:
@@ -224,11 +241,20 @@ def measure(name: str, runs: int) -> dict:
         assert again.coverage == plan.coverage and np.array_equal(again.q, plan.q), name
     steps = footsteps(plan)
     best, median = 1e3 * min(cpu), 1e3 * statistics.median(cpu)
-    return {"guide_poses": len(guide), "guide_length_m": float(np.hypot(*np.diff(guide[:, :2], axis=0).T).sum()),
-            "postures": len(plan), "footsteps": steps, "coverage": float(plan.coverage),
-            "best_ms": best, "median_ms": median,
-            "best_ms_per_footstep": best / max(steps, 1), "median_ms_per_footstep": median / max(steps, 1),
-            "wall_best_ms": 1e3 * min(wall), "wall_median_ms": 1e3 * statistics.median(wall), "runs": runs}
+    return {
+        "guide_poses": len(guide),
+        "guide_length_m": float(np.hypot(*np.diff(guide[:, :2], axis=0).T).sum()),
+        "postures": len(plan),
+        "footsteps": steps,
+        "coverage": float(plan.coverage),
+        "best_ms": best,
+        "median_ms": median,
+        "best_ms_per_footstep": best / max(steps, 1),
+        "median_ms_per_footstep": median / max(steps, 1),
+        "wall_best_ms": 1e3 * min(wall),
+        "wall_median_ms": 1e3 * statistics.median(wall),
+        "runs": runs,
+    }
 
 
 def profile(name: str, runs: int) -> None:
@@ -304,19 +330,28 @@ def check_reference(path: str) -> bool:
             if f"{key}_{name}" in data and not same_array(getattr(plan, key), data[f"{key}_{name}"]):
                 print(f"case {name}: {key} differs")
                 same = False
-    print(f"{int(data['count'])} arena guides and {len(CASES)} cases: {'identical' if same else 'DIFFERENT'} plans")
+    print(
+        f"{int(data['count'])} arena guides and {len(CASES)} cases: {'identical' if same else 'DIFFERENT'} plans"
+    )
     return same
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=20, help="timed runs per guide after one warm-up (>= 20)")
-    parser.add_argument("--profile", choices=sorted([*CASES, "arena"]), help="print a cProfile of this guide instead")
-    parser.add_argument("--cases", default=",".join([*CASES, "arena"]),
-                        help="comma-separated cases to time (flat, uturn, stairs, arena)")
+    parser.add_argument(
+        "--profile", choices=sorted([*CASES, "arena"]), help="print a cProfile of this guide instead"
+    )
+    parser.add_argument(
+        "--cases",
+        default=",".join([*CASES, "arena"]),
+        help="comma-separated cases to time (flat, uturn, stairs, arena)",
+    )
     parser.add_argument("--arena-runs", type=int, default=3, help="timed runs of the arena workload")
     parser.add_argument("--save-reference", metavar="NPZ", help="save the arena guides and plans, then exit")
-    parser.add_argument("--check-reference", metavar="NPZ", help="re-plan saved arena guides, compare, then exit")
+    parser.add_argument(
+        "--check-reference", metavar="NPZ", help="re-plan saved arena guides, compare, then exit"
+    )
     args = parser.parse_args(argv)
     if args.save_reference:
         save_reference(args.save_reference)
@@ -333,40 +368,62 @@ def main(argv=None) -> None:
     load_before = os.getloadavg()[0]
     results = {name: measure(name, args.runs) for name in CASES if name in names}
     arena = measure_arena(args.arena_runs) if "arena" in names else None
-    print(f"CPU ms per path ((wall) = wall-clock median), load average {load_before:.2f} before, "
-          f"{os.getloadavg()[0]:.2f} after")
+    print(
+        f"CPU ms per path ((wall) = wall-clock median), load average {load_before:.2f} before, "
+        f"{os.getloadavg()[0]:.2f} after"
+    )
     summary = {}
     if results:
         mean_step = statistics.mean(r["median_ms_per_footstep"] for r in results.values())
-        print(f"{'guide':8s} {'poses':>5s} {'steps':>5s} {'coverage':>8s} {'best ms':>8s} {'median ms':>9s} "
-              f"{'(wall)':>7s} {'ms/step (median)':>16s}")
+        print(
+            f"{'guide':8s} {'poses':>5s} {'steps':>5s} {'coverage':>8s} {'best ms':>8s} {'median ms':>9s} "
+            f"{'(wall)':>7s} {'ms/step (median)':>16s}"
+        )
         for name, r in results.items():
-            print(f"{name:8s} {r['guide_poses']:5d} {r['footsteps']:5d} {r['coverage']:8.3f} {r['best_ms']:8.1f} "
-                  f"{r['median_ms']:9.1f} {r['wall_median_ms']:7.1f} {r['median_ms_per_footstep']:16.2f}")
+            print(
+                f"{name:8s} {r['guide_poses']:5d} {r['footsteps']:5d} {r['coverage']:8.3f} {r['best_ms']:8.1f} "
+                f"{r['median_ms']:9.1f} {r['wall_median_ms']:7.1f} {r['median_ms_per_footstep']:16.2f}"
+            )
         summary["mean_median_ms_per_footstep"] = mean_step
         summary["footstep_target_met"] = mean_step <= STEP_TARGET_MS
         if "flat" in results:
             flat = results["flat"]
             flat_ok = flat["median_ms"] <= PATH_TARGET_MS
-            print(f"flat path (target <= {PATH_TARGET_MS:.0f} ms): best {flat['best_ms']:.1f} ms "
-                  f"({'met' if flat['best_ms'] <= PATH_TARGET_MS else 'MISSED'}), median {flat['median_ms']:.1f} ms "
-                  f"({'met' if flat_ok else 'MISSED'})")
+            print(
+                f"flat path (target <= {PATH_TARGET_MS:.0f} ms): best {flat['best_ms']:.1f} ms "
+                f"({'met' if flat['best_ms'] <= PATH_TARGET_MS else 'MISSED'}), median {flat['median_ms']:.1f} ms "
+                f"({'met' if flat_ok else 'MISSED'})"
+            )
             summary["flat_target_met"] = flat_ok
             summary["flat_target_met_best"] = flat["best_ms"] <= PATH_TARGET_MS
-        print(f"mean over guides: {mean_step:.2f} ms per footstep (target <= {STEP_TARGET_MS:.0f}): "
-              f"{'met' if mean_step <= STEP_TARGET_MS else 'MISSED'}")
+        print(
+            f"mean over guides: {mean_step:.2f} ms per footstep (target <= {STEP_TARGET_MS:.0f}): "
+            f"{'met' if mean_step <= STEP_TARGET_MS else 'MISSED'}"
+        )
     if arena is not None:
-        print(f"arena: {arena['guides']} guides ({arena['failed_guides']} fail part-way, mean coverage "
-              f"{arena['mean_coverage']:.3f}), {arena['guide_poses']} guide poses: "
-              f"{arena['poses_per_cpu_s_median']:.0f} guide poses per CPU-second (median of {arena['runs']}; "
-              f"best {arena['poses_per_cpu_s_best']:.0f}; {arena['covered_poses_per_cpu_s_median']:.0f} covered poses "
-              f"per CPU-second), {arena['median_s']:.2f} s CPU per workload")
+        print(
+            f"arena: {arena['guides']} guides ({arena['failed_guides']} fail part-way, mean coverage "
+            f"{arena['mean_coverage']:.3f}), {arena['guide_poses']} guide poses: "
+            f"{arena['poses_per_cpu_s_median']:.0f} guide poses per CPU-second (median of {arena['runs']}; "
+            f"best {arena['poses_per_cpu_s_best']:.0f}; {arena['covered_poses_per_cpu_s_median']:.0f} covered poses "
+            f"per CPU-second), {arena['median_s']:.2f} s CPU per workload"
+        )
         results["arena"] = arena
-    save("contact_planner_speed", {
-        "threads": 1, "clock": "process_time (CPU); wall_* perf_counter", "timestep_s": DT, "speed_m_s": SPEED,
-        "load_average_1min_before": load_before, "load_average_1min_after": os.getloadavg()[0],
-        "targets": {"flat_path_ms": PATH_TARGET_MS, "ms_per_footstep": STEP_TARGET_MS},
-        "cases": results, **summary})
+    save(
+        "contact_planner_speed",
+        {
+            "threads": 1,
+            "clock": "process_time (CPU); wall_* perf_counter",
+            "timestep_s": DT,
+            "speed_m_s": SPEED,
+            "load_average_1min_before": load_before,
+            "load_average_1min_after": os.getloadavg()[0],
+            "targets": {"flat_path_ms": PATH_TARGET_MS, "ms_per_footstep": STEP_TARGET_MS},
+            "cases": results,
+            **summary,
+        },
+    )
+
 
 if __name__ == "__main__":
     main()

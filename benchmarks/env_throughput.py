@@ -16,7 +16,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import jax  # noqa: E402
-
 from common import save  # noqa: E402
 
 
@@ -47,8 +46,14 @@ def measure(field, num_envs: int, steps: int, repeats: int) -> dict:
         episodes = int(run(field, jax.random.PRNGKey(r + 1)).block_until_ready())
         times.append(time.perf_counter() - t0)
     best = min(times)
-    return {"num_envs": num_envs, "steps": steps, "compile_s": round(compile_s, 3), "run_s": round(best, 4),
-            "steps_per_s": round(num_envs * steps / best), "episodes_ended": episodes}
+    return {
+        "num_envs": num_envs,
+        "steps": steps,
+        "compile_s": round(compile_s, 3),
+        "run_s": round(best, 4),
+        "steps_per_s": round(num_envs * steps / best),
+        "episodes_ended": episodes,
+    }
 
 
 def main() -> None:
@@ -67,10 +72,20 @@ def main() -> None:
     for n in [int(v) for v in args.envs.split(",")]:
         row = measure(field, n, args.steps, args.repeats)
         rows.append(row)
-        print(f"num_envs {n:6d}: {row['steps_per_s']:>12,} steps/s  (compile {row['compile_s']:.1f} s)", flush=True)
+        print(
+            f"num_envs {n:6d}: {row['steps_per_s']:>12,} steps/s  (compile {row['compile_s']:.1f} s)",
+            flush=True,
+        )
     best = max(rows, key=lambda r: r["steps_per_s"])
-    save("env_throughput", {"terrain": args.terrain, "rows": rows, "best_steps_per_s": best["steps_per_s"],
-                            "best_num_envs": best["num_envs"]})
+    save(
+        "env_throughput",
+        {
+            "terrain": args.terrain,
+            "rows": rows,
+            "best_steps_per_s": best["steps_per_s"],
+            "best_num_envs": best["num_envs"],
+        },
+    )
 
 
 if __name__ == "__main__":

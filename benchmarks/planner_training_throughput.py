@@ -19,7 +19,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-
 from common import save  # noqa: E402
 
 
@@ -41,19 +40,31 @@ def main() -> None:
     records = []
     with tempfile.TemporaryDirectory() as out:
         t0 = time.perf_counter()
-        train(config, out, progress=False, workers=args.workers, on_log=records.append,
-              stop_after_iterations=args.iterations)
+        train(
+            config,
+            out,
+            progress=False,
+            workers=args.workers,
+            on_log=records.append,
+            stop_after_iterations=args.iterations,
+        )
         wall = time.perf_counter() - t0
     steady = records[1:] or records  # the first iteration includes compilation and worker start-up
     kept = sum(r["kept_steps"] for r in steady)
     rolled = sum(r["rolled_steps"] for r in steady)
     span = steady[-1]["wall_s"] - (records[0]["wall_s"] if len(records) > 1 else 0.0)
-    row = {"iterations": len(records), "workers": args.workers, "episodes_per_batch": args.num_envs,
-           "init": args.init, "wall_s_total": round(wall, 1),
-           "kept_steps_per_s": round(kept / span, 1), "rolled_steps_per_s": round(rolled / span, 1),
-           "wait_fraction": round(float(np.mean([r["wait_fraction"] for r in steady])), 3),
-           "discarded_fraction": round(float(np.mean([r["discarded_fraction"] for r in steady])), 3),
-           "mean_coverage": round(float(np.mean([r["mean_coverage"] for r in steady])), 3)}
+    row = {
+        "iterations": len(records),
+        "workers": args.workers,
+        "episodes_per_batch": args.num_envs,
+        "init": args.init,
+        "wall_s_total": round(wall, 1),
+        "kept_steps_per_s": round(kept / span, 1),
+        "rolled_steps_per_s": round(rolled / span, 1),
+        "wait_fraction": round(float(np.mean([r["wait_fraction"] for r in steady])), 3),
+        "discarded_fraction": round(float(np.mean([r["discarded_fraction"] for r in steady])), 3),
+        "mean_coverage": round(float(np.mean([r["mean_coverage"] for r in steady])), 3),
+    }
     for k, v in row.items():
         print(f"{k:22s} {v}")
     save("planner_training_throughput", row)

@@ -23,14 +23,17 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 
 from common import save  # noqa: E402
 
-SETTINGS = (("local processes", dict(workers=1)), ("local processes", dict(workers=2)),
-            ("local Ray actors", dict(address="local", workers=1)),
-            ("local Ray actors", dict(address="local", workers=2)))
+SETTINGS = (
+    ("local processes", dict(workers=1)),
+    ("local processes", dict(workers=2)),
+    ("local Ray actors", dict(address="local", workers=1)),
+    ("local Ray actors", dict(address="local", workers=2)),
+)
 
 
 def measure(terrain, guides, timestep: float, runs: int, options: dict) -> tuple[dict, list]:
     """Seconds to open and warm a pool, and per timed batch; the last batch's results."""
-    from leas_jax.contacts.pool import ValidationPool
+    from leas_jax.contacts.validation.pool import ValidationPool
 
     began = time.perf_counter()
     with ValidationPool(terrain, return_plans=False, **options) as pool:
@@ -59,8 +62,11 @@ def main() -> None:
         if results != reference:
             raise SystemExit(f"{backend} {options}: results differ from 1 local process")
         rows.append({"backend": backend, "workers": options["workers"], "paths": len(guides), **figures})
-        print(f"{backend:17s} x{options['workers']}: open+warm {figures['open_and_warm_s']:.1f} s, "
-              f"{len(guides)} paths in {', '.join(f'{s:.2f}' for s in figures['batch_s'])} s", flush=True)
+        print(
+            f"{backend:17s} x{options['workers']}: open+warm {figures['open_and_warm_s']:.1f} s, "
+            f"{len(guides)} paths in {', '.join(f'{s:.2f}' for s in figures['batch_s'])} s",
+            flush=True,
+        )
     save("ray_validation", {"runs": args.runs, "rows": rows})
 
 

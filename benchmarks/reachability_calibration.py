@@ -1,8 +1,8 @@
-"""Calibrate the reachability condition (DESIGN §5) against the contact generator.
+"""Calibrate the reachability condition (docs/design.md §5) against the contact generator.
 
 Ground truth: a root pose (x, y, z, yaw) is *feasible* when the contact generator
 finds a balanced, collision-free double-support posture there
-(`leas_jax.contacts.generator.double_support_posture`: what it does for the first
+(`leas_jax.contacts.planner.generator.double_support_posture`: what it does for the first
 posture of a plan, root offsets included). The condition is
 `leas_jax.env.reachability.valid` (jitted, vmapped) on the Heightfield of the
 terrain. Figures: sensitivity = P(condition | feasible), specificity =
@@ -121,8 +121,15 @@ HANDS_GRID = {
 
 # ------------------------------------------------------------------ poses
 
-def sample_poses(terrain, count: int, seed: int = 0, nominal: float = 1.0,
-                 near_fraction: float = NEAR_FRACTION, z_offsets=Z_OFFSETS) -> np.ndarray:
+
+def sample_poses(
+    terrain,
+    count: int,
+    seed: int = 0,
+    nominal: float = 1.0,
+    near_fraction: float = NEAR_FRACTION,
+    z_offsets=Z_OFFSETS,
+) -> np.ndarray:
     """Seeded root poses on a terrain (see the module docstring).
 
     Args:
@@ -142,11 +149,16 @@ def sample_poses(terrain, count: int, seed: int = 0, nominal: float = 1.0,
     (x0, y0), (x1, y1) = terrain.bounds
     margin = 0.3  # m, keep the legs' disks on the raster
     n_near = int(round(near_fraction * count))
-    xy = np.column_stack([rng.uniform(x0 + margin, x1 - margin, count - n_near),
-                          rng.uniform(y0 + margin, y1 - margin, count - n_near)])
+    xy = np.column_stack(
+        [
+            rng.uniform(x0 + margin, x1 - margin, count - n_near),
+            rng.uniform(y0 + margin, y1 - margin, count - n_near),
+        ]
+    )
     if n_near:
-        spread = disk_filter(heights, 0.35 / res, "max", terrain.void_height) - \
-            disk_filter(heights, 0.35 / res, "min", terrain.void_height)
+        spread = disk_filter(heights, 0.35 / res, "max", terrain.void_height) - disk_filter(
+            heights, 0.35 / res, "min", terrain.void_height
+        )
         # Not the raster border, where the void outside makes every point look "near".
         border = int(np.ceil((margin + 0.35) / res))
         spread[:border], spread[-border:], spread[:, :border], spread[:, -border:] = 0, 0, 0, 0
@@ -169,7 +181,7 @@ _WORKER = {}
 
 
 def _init_worker(terrain_text: str) -> None:
-    from leas_jax.contacts.generator import ContactGenerator
+    from leas_jax.contacts.planner.generator import ContactGenerator
     from leas_jax.terrain import loads_terrain
 
     _WORKER["generator"] = ContactGenerator(loads_terrain(terrain_text, source="<calibration>"))
@@ -201,7 +213,9 @@ def _feasible_chunk(job) -> np.ndarray:
     return np.array([_feasible_one(generator, pose, truth) for pose in poses], dtype=bool)
 
 
-def ground_truth(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100, truth: str = "static") -> np.ndarray:
+def ground_truth(
+    terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100, truth: str = "static"
+) -> np.ndarray:
     """[N] whether the contact generator stands at each pose [N, 4] (truth "static": a
     double-support posture; "walking": a plan covering a short straight guide from it).
 
@@ -210,7 +224,7 @@ def ground_truth(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 100,
     ContactGenerator per worker; results keep the order of `poses`.
     """
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4)
-    chunks = [(poses[k:k + chunk], truth) for k in range(0, len(poses), chunk)]
+    chunks = [(poses[k : k + chunk], truth) for k in range(0, len(poses), chunk)]
     if workers <= 1:
         _init_worker(terrain.text)
         parts = [_feasible_chunk(c) for c in chunks]
@@ -238,8 +252,9 @@ def cache_path(truth: str, seed: int, count: int) -> Path:
     return REPO / ".cache" / f"reachability_ground_truth_{truth}_seed{seed}_{count}.npz"
 
 
-def cached_ground_truth(terrain, poses: np.ndarray, truth: str = "static", workers: int = 2,
-                        reuse: bool = True, seed: int = 0) -> tuple[np.ndarray, float]:
+def cached_ground_truth(
+    terrain, poses: np.ndarray, truth: str = "static", workers: int = 2, reuse: bool = True, seed: int = 0
+) -> tuple[np.ndarray, float]:
     """`ground_truth` of poses [N, 4] (drawn with `seed`), from the cache
     (`cache_path(truth, seed, N)`) when `reuse` and it holds the same poses and generator
     fingerprint; otherwise computed and cached. Returns (truth [N] bool, seconds it took
@@ -253,7 +268,9 @@ def cached_ground_truth(terrain, poses: np.ndarray, truth: str = "static", worke
             if same_poses and same_generator:
                 print(f"reused the ground truth of {cache}")
                 return data["truth"], float(data["seconds"])
-            print(f"not reusing {cache}: " + ("the contact generator changed" if same_poses else "other poses"))
+            print(
+                f"not reusing {cache}: " + ("the contact generator changed" if same_poses else "other poses")
+            )
     start = time.perf_counter()
     result = ground_truth(terrain, poses, workers, truth=truth)
     seconds = time.perf_counter() - start
@@ -264,21 +281,29 @@ def cached_ground_truth(terrain, poses: np.ndarray, truth: str = "static", worke
 
 # ------------------------------------------------------------------ condition
 
+
 def condition(terrain, poses: np.ndarray, config) -> np.ndarray:
     """[N] `reachability.valid` (jitted, vmapped) at poses [N, 4] with `config` (a ReachabilityConfig)."""
     import jax
     import jax.numpy as jnp
 
-    from leas_jax.env import EnvConfig, heightfield_from_terrain
-    from leas_jax.env import reachability
+    from leas_jax.env import EnvConfig, heightfield_from_terrain, reachability
 
     field = heightfield_from_terrain(terrain, EnvConfig(reachability=config))
     valid = jax.jit(jax.vmap(lambda f, p: reachability.valid(f, p, config), in_axes=(None, 0)))
     return np.asarray(valid(field, jnp.asarray(poses, dtype=jnp.float32)))
 
 
-def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: float,
-                   leg_lateral_offset: float, leg_forward: float = 0.0, foothold=None, hand_radius=None) -> dict:
+def raster_samples(
+    terrain,
+    poses: np.ndarray,
+    trunk_radius: float,
+    leg_radius: float,
+    leg_lateral_offset: float,
+    leg_forward: float = 0.0,
+    foothold=None,
+    hand_radius=None,
+) -> dict:
     """What the condition reads, per pose, for one set of radii (jitted, vmapped).
 
     Args:
@@ -301,28 +326,50 @@ def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: 
     from leas_jax.env.field import heightfield_from_raster, sample_nearest
     from leas_jax.env.reachability import all_leg_centers, hand_centers
 
-    extra = {} if foothold is None else {"foothold_radius": foothold[0], "foothold_search": foothold[1],
-                                         "foothold_spread": 0.0}  # any value: builds the raster
-    config = ReachabilityConfig(trunk_radius=trunk_radius, leg_radius=leg_radius,
-                                leg_lateral_offset=leg_lateral_offset, leg_forward=leg_forward,
-                                hand_radius=hand_radius, **extra)
+    extra = (
+        {}
+        if foothold is None
+        else {"foothold_radius": foothold[0], "foothold_search": foothold[1], "foothold_spread": 0.0}
+    )  # any value: builds the raster
+    config = ReachabilityConfig(
+        trunk_radius=trunk_radius,
+        leg_radius=leg_radius,
+        leg_lateral_offset=leg_lateral_offset,
+        leg_forward=leg_forward,
+        hand_radius=hand_radius,
+        **extra,
+    )
     # The environment's own rasters (the void is no floor for the legs); spawn points are
     # not needed here, and the grid visits radii where there may be none.
-    field = heightfield_from_raster(terrain.raster(), terrain.bounds[0], terrain.resolution, terrain.void_height,
-                                    EnvConfig(reachability=config), require_spawn=False)
+    field = heightfield_from_raster(
+        terrain.raster(),
+        terrain.bounds[0],
+        terrain.resolution,
+        terrain.void_height,
+        EnvConfig(reachability=config),
+        require_spawn=False,
+    )
 
     def one(f, pose):
         legs = all_leg_centers(pose, config)
-        return (sample_nearest(f, f.trunk_max, pose[:2]), sample_nearest(f, f.leg_max, legs, outside=-jnp.inf),
-                sample_nearest(f, f.leg_min, legs, outside=jnp.inf),
-                sample_nearest(f, f.foothold, legs, outside=jnp.inf) if foothold is not None else jnp.zeros(0),
-                sample_nearest(f, f.hand_max, hand_centers(pose, config), outside=-jnp.inf)
-                if hand_radius is not None else jnp.zeros(0))
+        return (
+            sample_nearest(f, f.trunk_max, pose[:2]),
+            sample_nearest(f, f.leg_max, legs, outside=-jnp.inf),
+            sample_nearest(f, f.leg_min, legs, outside=jnp.inf),
+            sample_nearest(f, f.foothold, legs, outside=jnp.inf) if foothold is not None else jnp.zeros(0),
+            sample_nearest(f, f.hand_max, hand_centers(pose, config), outside=-jnp.inf)
+            if hand_radius is not None
+            else jnp.zeros(0),
+        )
 
     poses32 = jnp.asarray(poses, dtype=jnp.float32)
     trunk, leg_max, leg_min, flat, hand = jax.jit(jax.vmap(one, in_axes=(None, 0)))(field, poses32)
-    out = {"z": np.asarray(poses32[:, 2]), "trunk": np.asarray(trunk), "leg_max": np.asarray(leg_max),
-           "leg_min": np.asarray(leg_min)}
+    out = {
+        "z": np.asarray(poses32[:, 2]),
+        "trunk": np.asarray(trunk),
+        "leg_max": np.asarray(leg_max),
+        "leg_min": np.asarray(leg_min),
+    }
     if foothold is not None:
         out["foothold"] = np.asarray(flat)
     if hand_radius is not None:
@@ -330,7 +377,9 @@ def raster_samples(terrain, poses: np.ndarray, trunk_radius: float, leg_radius: 
     return out
 
 
-def thresholds(samples: dict, trunk_bottom, leg_bottom, leg_top, foothold_spread=None, hand_bottom=None) -> np.ndarray:
+def thresholds(
+    samples: dict, trunk_bottom, leg_bottom, leg_top, foothold_spread=None, hand_bottom=None
+) -> np.ndarray:
     """The condition of `reachability.terms` from `raster_samples`, for many thresholds at once.
 
     Args:
@@ -385,14 +434,25 @@ def flat_ground_ok(trunk_bottom, leg_bottom, leg_top, heights=FLAT_HEIGHTS, marg
     touch iff h + leg_bottom <= 0 <= h + leg_top.
     """
     lo, hi = min(heights), max(heights)
-    return ((np.asarray(trunk_bottom) + lo >= margin) & (np.asarray(leg_bottom) + hi <= -margin) &
-            (np.asarray(leg_top) + lo >= margin))
+    return (
+        (np.asarray(trunk_bottom) + lo >= margin)
+        & (np.asarray(leg_bottom) + hi <= -margin)
+        & (np.asarray(leg_top) + lo >= margin)
+    )
 
 
 # ------------------------------------------------------------------ search
 
-def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, base_config,
-                grid: dict = GRID, terms_grid: dict | None = None) -> dict:
+
+def grid_search(
+    terrain,
+    poses: np.ndarray,
+    truth: np.ndarray,
+    fit: np.ndarray,
+    base_config,
+    grid: dict = GRID,
+    terms_grid: dict | None = None,
+) -> dict:
     """Best cylinder parameters over `grid` (see the module docstring).
 
     Args:
@@ -414,36 +474,78 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
     tb, lb, lt = tb.ravel(), lb.ravel(), lt.ravel()
     allowed = flat_ground_ok(tb, lb, lt)
     tb, lb, lt = tb[allowed], lb[allowed], lt[allowed]
-    hands = (base_config.hand_radius,) if terms_grid is None else terms_grid.get("hand", (base_config.hand_radius,))
-    hand_bottoms = (base_config.hand_bottom,) if terms_grid is None else terms_grid.get("hand_bottom",
-                                                                                       (base_config.hand_bottom,))
+    hands = (
+        (base_config.hand_radius,)
+        if terms_grid is None
+        else terms_grid.get("hand", (base_config.hand_radius,))
+    )
+    hand_bottoms = (
+        (base_config.hand_bottom,)
+        if terms_grid is None
+        else terms_grid.get("hand_bottom", (base_config.hand_bottom,))
+    )
     if terms_grid is None:
-        radii = itertools.product(grid["trunk_radius"], grid["leg_radius"], (base_config.leg_forward,),
-                                  (None if base_config.foothold_spread is None else
-                                   (base_config.foothold_radius, base_config.foothold_search),), hands)
+        radii = itertools.product(
+            grid["trunk_radius"],
+            grid["leg_radius"],
+            (base_config.leg_forward,),
+            (
+                None
+                if base_config.foothold_spread is None
+                else (base_config.foothold_radius, base_config.foothold_search),
+            ),
+            hands,
+        )
         spreads = (base_config.foothold_spread,)
     else:
-        radii = itertools.product(terms_grid["trunk_radius"], terms_grid["leg_radius"], terms_grid["leg_forward"],
-                                  terms_grid["foothold"], hands)
+        radii = itertools.product(
+            terms_grid["trunk_radius"],
+            terms_grid["leg_radius"],
+            terms_grid["leg_forward"],
+            terms_grid["foothold"],
+            hands,
+        )
         spreads = terms_grid["foothold_spread"]
     best, table = None, []
-    base = np.array([base_config.trunk_radius, base_config.leg_radius, base_config.trunk_bottom,
-                     base_config.leg_bottom, base_config.leg_top])
+    base = np.array(
+        [
+            base_config.trunk_radius,
+            base_config.leg_radius,
+            base_config.trunk_bottom,
+            base_config.leg_bottom,
+            base_config.leg_top,
+        ]
+    )
     for trunk_radius, leg_radius, leg_forward, foothold, hand in radii:
-        samples = raster_samples(terrain, poses[fit], trunk_radius, leg_radius, base_config.leg_lateral_offset,
-                                 leg_forward, foothold, hand)
-        for spread, hand_bottom in itertools.product((None,) if foothold is None else spreads,
-                                                     (None,) if hand is None else hand_bottoms):
+        samples = raster_samples(
+            terrain,
+            poses[fit],
+            trunk_radius,
+            leg_radius,
+            base_config.leg_lateral_offset,
+            leg_forward,
+            foothold,
+            hand,
+        )
+        for spread, hand_bottom in itertools.product(
+            (None,) if foothold is None else spreads, (None,) if hand is None else hand_bottoms
+        ):
             figures = confusion(thresholds(samples, tb, lb, lt, spread, hand_bottom), truth[fit])
             sens, spec = figures["sensitivity"], figures["specificity"]
             youden = sens + spec - 1
             sensitive = sens >= TARGET_SENSITIVITY
             met = sensitive & (spec >= TARGET_SPECIFICITY)
             score = np.round(np.where(met, youden, np.where(sensitive, spec, youden)), 4)
-            params = np.column_stack([np.full(len(tb), trunk_radius), np.full(len(tb), leg_radius), tb, lb, lt])
+            params = np.column_stack(
+                [np.full(len(tb), trunk_radius), np.full(len(tb), leg_radius), tb, lb, lt]
+            )
             # tie-break: closest to the old defaults, and an optional term counts as 0.1 m away
-            distance = (np.abs(params - base).sum(axis=1) + abs(leg_forward - base_config.leg_forward)
-                        + 0.1 * (spread is not None) + 0.1 * (hand is not None))
+            distance = (
+                np.abs(params - base).sum(axis=1)
+                + abs(leg_forward - base_config.leg_forward)
+                + 0.1 * (spread is not None)
+                + 0.1 * (hand is not None)
+            )
             # Rank: both targets met (then the best Youden index); else the sensitivity
             # target met (then the best specificity: a false negative ends episodes the
             # generator could have walked, for good, while a false positive is caught by
@@ -451,78 +553,126 @@ def grid_search(terrain, poses: np.ndarray, truth: np.ndarray, fit: np.ndarray, 
             # Scores are rounded so that near-ties go to the parameters closest to the old defaults.
             key = np.lexsort((distance, -score, ~sensitive, ~met))
             k = int(key[0])
-            row = {"trunk_radius": trunk_radius, "leg_radius": leg_radius, "trunk_bottom": float(tb[k]),
-                   "leg_bottom": float(lb[k]), "leg_top": float(lt[k]), "leg_forward": float(leg_forward),
-                   "foothold_radius": None if spread is None else float(foothold[0]),
-                   "foothold_search": None if spread is None else float(foothold[1]),
-                   "foothold_spread": None if spread is None else float(spread),
-                   "hand_radius": None if hand is None else float(hand),
-                   "hand_bottom": None if hand is None else float(hand_bottom), "met": bool(met[k]),
-                   "sensitive": bool(sensitive[k]), "score": float(score[k]),
-                   "sensitivity": float(sens[k]), "specificity": float(spec[k]), "youden": float(youden[k]),
-                   "distance": float(distance[k])}
+            row = {
+                "trunk_radius": trunk_radius,
+                "leg_radius": leg_radius,
+                "trunk_bottom": float(tb[k]),
+                "leg_bottom": float(lb[k]),
+                "leg_top": float(lt[k]),
+                "leg_forward": float(leg_forward),
+                "foothold_radius": None if spread is None else float(foothold[0]),
+                "foothold_search": None if spread is None else float(foothold[1]),
+                "foothold_spread": None if spread is None else float(spread),
+                "hand_radius": None if hand is None else float(hand),
+                "hand_bottom": None if hand is None else float(hand_bottom),
+                "met": bool(met[k]),
+                "sensitive": bool(sensitive[k]),
+                "score": float(score[k]),
+                "sensitivity": float(sens[k]),
+                "specificity": float(spec[k]),
+                "youden": float(youden[k]),
+                "distance": float(distance[k]),
+            }
             table.append(row)
             rank = (not row["met"], not row["sensitive"], -row["score"], row["distance"])
             if best is None or rank < best[0]:
                 best = (rank, row)
     row = best[1]
-    fields = {k: row[k] for k in ("trunk_radius", "leg_radius", "trunk_bottom", "leg_bottom", "leg_top",
-                                  "leg_forward", "foothold_spread", "hand_radius")}
+    fields = {
+        k: row[k]
+        for k in (
+            "trunk_radius",
+            "leg_radius",
+            "trunk_bottom",
+            "leg_bottom",
+            "leg_top",
+            "leg_forward",
+            "foothold_spread",
+            "hand_radius",
+        )
+    }
     if row["foothold_spread"] is not None:
         fields.update(foothold_radius=row["foothold_radius"], foothold_search=row["foothold_search"])
     if row["hand_radius"] is not None:
         fields.update(hand_bottom=row["hand_bottom"])
     config = dataclasses.replace(base_config, **fields)
-    return {"config": config, "met": row["met"], "sensitive": row["sensitive"], "candidates": int(len(tb)) * len(table),
-            "fit_figures": {"sensitivity": row["sensitivity"], "specificity": row["specificity"]},
-            "table": table}
+    return {
+        "config": config,
+        "met": row["met"],
+        "sensitive": row["sensitive"],
+        "candidates": int(len(tb)) * len(table),
+        "fit_figures": {"sensitivity": row["sensitivity"], "specificity": row["specificity"]},
+        "table": table,
+    }
 
 
 def figures(terrain, poses, truth, config, fit) -> dict:
     """Figures of one config with the jitted `reachability.valid`, on all / fit / held-out poses."""
     predicted = condition(terrain, poses, config)
-    return {"all": confusion(predicted, truth), "fit": confusion(predicted[fit], truth[fit]),
-            "held_out": confusion(predicted[~fit], truth[~fit])}, predicted
+    return {
+        "all": confusion(predicted, truth),
+        "fit": confusion(predicted[fit], truth[fit]),
+        "held_out": confusion(predicted[~fit], truth[~fit]),
+    }, predicted
 
 
 def breakdown(poses, truth, predicted, terrain, nominal: float = 1.0) -> list[dict]:
     """Rates per band of root height above the reference ground (where the errors are)."""
     from leas_jax.env.field import disk_filter
 
-    reference = disk_filter(terrain.raster(), REFERENCE_RADIUS / terrain.resolution, "max", terrain.void_height)
-    ij = np.clip(np.round((poses[:, :2] - terrain.bounds[0]) / terrain.resolution).astype(int), 0,
-                 np.array(reference.shape) - 1)
+    reference = disk_filter(
+        terrain.raster(), REFERENCE_RADIUS / terrain.resolution, "max", terrain.void_height
+    )
+    ij = np.clip(
+        np.round((poses[:, :2] - terrain.bounds[0]) / terrain.resolution).astype(int),
+        0,
+        np.array(reference.shape) - 1,
+    )
     offset = poses[:, 2] - reference[ij[:, 0], ij[:, 1]] - nominal
     rows = []
     for lo in np.arange(Z_OFFSETS[0], Z_OFFSETS[1] - 1e-9, 0.1):
         band = (offset >= lo) & (offset < lo + 0.1)
         c = confusion(predicted[band], truth[band])
-        rows.append({"offset_from": round(float(lo), 2), "offset_to": round(float(lo + 0.1), 2),
-                     "poses": int(band.sum()), "feasible": int(truth[band].sum()), **c})
+        rows.append(
+            {
+                "offset_from": round(float(lo), 2),
+                "offset_to": round(float(lo + 0.1), 2),
+                "poses": int(band.sum()),
+                "feasible": int(truth[band].sum()),
+                **c,
+            }
+        )
     return rows
 
 
 def _describe(cfg) -> str:
     """One line of a ReachabilityConfig: cylinders and the optional terms."""
-    text = (f"trunk r {cfg.trunk_radius:.2f} [{cfg.trunk_bottom:+.3f}, {cfg.trunk_top:+.2f}], "
-            f"legs r {cfg.leg_radius:.2f} [{cfg.leg_bottom:+.3f}, {cfg.leg_top:+.3f}]")
+    text = (
+        f"trunk r {cfg.trunk_radius:.2f} [{cfg.trunk_bottom:+.3f}, {cfg.trunk_top:+.2f}], "
+        f"legs r {cfg.leg_radius:.2f} [{cfg.leg_bottom:+.3f}, {cfg.leg_top:+.3f}]"
+    )
     if cfg.leg_forward != 0.0:
         text += f", lookahead legs {cfg.leg_forward:+.2f} m"
     if cfg.foothold_spread is not None:
-        text += (f", foothold r {cfg.foothold_radius:.3f} within {cfg.foothold_search:.2f} m, "
-                 f"spread <= {cfg.foothold_spread:.3f} m")
+        text += (
+            f", foothold r {cfg.foothold_radius:.3f} within {cfg.foothold_search:.2f} m, "
+            f"spread <= {cfg.foothold_spread:.3f} m"
+        )
     if cfg.hand_radius is not None:
         text += f", hands r {cfg.hand_radius:.2f} below {cfg.hand_bottom:+.2f}"
     return text
 
 
 def _fmt(c: dict) -> str:
-    return (f"sens {100 * c['sensitivity']:5.1f} %  spec {100 * c['specificity']:5.1f} %  "
-            f"tp {c['tp']:5d} fn {c['fn']:5d} fp {c['fp']:5d} tn {c['tn']:5d}")
+    return (
+        f"sens {100 * c['sensitivity']:5.1f} %  spec {100 * c['specificity']:5.1f} %  "
+        f"tp {c['tp']:5d} fn {c['fn']:5d} fp {c['fp']:5d} tn {c['tn']:5d}"
+    )
 
 
 def main(argv=None) -> None:
     from common import save
+
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import REACHABILITY_TERMS_OFF, TRAINING_REACHABILITY
@@ -533,28 +683,52 @@ def main(argv=None) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--terrain", default=str(ARENA))
     parser.add_argument("--reuse", action="store_true", help="reuse the cached ground truth if it matches")
-    parser.add_argument("--truth", choices=("static", "walking"), default="static",
-                        help="feasible = a double-support posture (static, the issue's definition) or a plan "
-                             "covering a 0.36 m straight guide from the pose (walking)")
-    parser.add_argument("--baseline", default=None,
-                        help="old defaults as 'trunk_radius,trunk_bottom,trunk_top,leg_radius,leg_bottom,leg_top' "
-                             "(default: DESIGN §5 values)")
+    parser.add_argument(
+        "--truth",
+        choices=("static", "walking"),
+        default="static",
+        help="feasible = a double-support posture (static, the issue's definition) or a plan "
+        "covering a 0.36 m straight guide from the pose (walking)",
+    )
+    parser.add_argument(
+        "--baseline",
+        default=None,
+        help="old defaults as 'trunk_radius,trunk_bottom,trunk_top,leg_radius,leg_bottom,leg_top' "
+        "(default: docs/design.md §5 values)",
+    )
     args = parser.parse_args(argv)
 
     terrain = load_terrain(args.terrain)
-    # DESIGN §5 values: the defaults before this calibration.
-    old = ReachabilityConfig(trunk_radius=0.30, trunk_bottom=-0.63, trunk_top=0.60, leg_radius=0.25,
-                             leg_lateral_offset=0.085, leg_bottom=-1.06, leg_top=-0.54, **REACHABILITY_TERMS_OFF)
+    # docs/design.md §5 values: the defaults before this calibration.
+    old = ReachabilityConfig(
+        trunk_radius=0.30,
+        trunk_bottom=-0.63,
+        trunk_top=0.60,
+        leg_radius=0.25,
+        leg_lateral_offset=0.085,
+        leg_bottom=-1.06,
+        leg_top=-0.54,
+        **REACHABILITY_TERMS_OFF,
+    )
     if args.baseline:
         tr, tb, tt, lr, lb, lt = map(float, args.baseline.split(","))
-        old = ReachabilityConfig(trunk_radius=tr, trunk_bottom=tb, trunk_top=tt, leg_radius=lr, leg_bottom=lb,
-                                 leg_top=lt, **REACHABILITY_TERMS_OFF)
+        old = ReachabilityConfig(
+            trunk_radius=tr,
+            trunk_bottom=tb,
+            trunk_top=tt,
+            leg_radius=lr,
+            leg_bottom=lb,
+            leg_top=lt,
+            **REACHABILITY_TERMS_OFF,
+        )
     poses = sample_poses(terrain, args.poses, args.seed)
     suffix = "" if args.truth == "static" else f"_{args.truth}"
     truth, gt_seconds = cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse, args.seed)
-    print(f"ground truth: {len(poses)} poses, {int(truth.sum())} feasible, {gt_seconds:.0f} s "
-          f"with {args.workers} workers ({1e3 * gt_seconds * max(args.workers, 1) / len(poses):.1f} ms per pose "
-          f"per worker)")
+    print(
+        f"ground truth: {len(poses)} poses, {int(truth.sum())} feasible, {gt_seconds:.0f} s "
+        f"with {args.workers} workers ({1e3 * gt_seconds * max(args.workers, 1) / len(poses):.1f} ms per pose "
+        f"per worker)"
+    )
     fit = np.random.default_rng(args.seed + 1).random(len(poses)) < 2 / 3
 
     start = time.perf_counter()
@@ -566,11 +740,18 @@ def main(argv=None) -> None:
     terms_seconds = time.perf_counter() - start
     with_terms = terms_search["config"]
     start = time.perf_counter()
-    hands_grid = {"trunk_radius": (with_terms.trunk_radius,), "leg_radius": (with_terms.leg_radius,),
-                  "leg_forward": TERMS_GRID["leg_forward"],
-                  "foothold": (None if with_terms.foothold_spread is None else
-                               (with_terms.foothold_radius, with_terms.foothold_search),),
-                  "foothold_spread": (with_terms.foothold_spread,), **HANDS_GRID}
+    hands_grid = {
+        "trunk_radius": (with_terms.trunk_radius,),
+        "leg_radius": (with_terms.leg_radius,),
+        "leg_forward": TERMS_GRID["leg_forward"],
+        "foothold": (
+            None
+            if with_terms.foothold_spread is None
+            else (with_terms.foothold_radius, with_terms.foothold_search),
+        ),
+        "foothold_spread": (with_terms.foothold_spread,),
+        **HANDS_GRID,
+    }
     hands_search = grid_search(terrain, poses, truth, fit, old, terms_grid=hands_grid)
     hands_seconds = time.perf_counter() - start
     with_hands = hands_search["config"]
@@ -585,90 +766,170 @@ def main(argv=None) -> None:
     mismatch = 0
     for cfg, pred in ((new, new_pred), (with_terms, terms_pred), (with_hands, hands_pred)):
         foothold = None if cfg.foothold_spread is None else (cfg.foothold_radius, cfg.foothold_search)
-        samples = raster_samples(terrain, poses, cfg.trunk_radius, cfg.leg_radius, cfg.leg_lateral_offset,
-                                 cfg.leg_forward, foothold, cfg.hand_radius)
-        mismatch += int(np.sum(thresholds(samples, cfg.trunk_bottom, cfg.leg_bottom, cfg.leg_top,
-                                          cfg.foothold_spread,
-                                          None if cfg.hand_radius is None else cfg.hand_bottom) != pred))
+        samples = raster_samples(
+            terrain,
+            poses,
+            cfg.trunk_radius,
+            cfg.leg_radius,
+            cfg.leg_lateral_offset,
+            cfg.leg_forward,
+            foothold,
+            cfg.hand_radius,
+        )
+        mismatch += int(
+            np.sum(
+                thresholds(
+                    samples,
+                    cfg.trunk_bottom,
+                    cfg.leg_bottom,
+                    cfg.leg_top,
+                    cfg.foothold_spread,
+                    None if cfg.hand_radius is None else cfg.hand_bottom,
+                )
+                != pred
+            )
+        )
 
-    print(f"\ngrid search: {search['candidates']} candidates in {search_seconds:.1f} s; best per radius pair "
-          f"(fitting poses):")
-    print(f"{'trunk r':>7s} {'leg r':>5s} {'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} "
-          f"{'sens %':>6s} {'spec %':>6s} {'met':>4s}")
+    print(
+        f"\ngrid search: {search['candidates']} candidates in {search_seconds:.1f} s; best per radius pair "
+        f"(fitting poses):"
+    )
+    print(
+        f"{'trunk r':>7s} {'leg r':>5s} {'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} "
+        f"{'sens %':>6s} {'spec %':>6s} {'met':>4s}"
+    )
     for row in search["table"]:
-        print(f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
-              f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {100 * row['sensitivity']:6.1f} "
-              f"{100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
+        print(
+            f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
+            f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {100 * row['sensitivity']:6.1f} "
+            f"{100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}"
+        )
     rank = lambda r: (not r["met"], not r["sensitive"], -r["score"], r["distance"])  # noqa: E731
-    print(f"\nsearch with the optional terms: {terms_search['candidates']} candidates in {terms_seconds:.1f} s; "
-          f"the 12 best settings (fitting poses):")
-    print(f"{'trunk r':>7s} {'leg r':>5s} {'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} {'fwd':>5s} "
-          f"{'foothold r/search/spread':>24s} {'sens %':>6s} {'spec %':>6s} {'met':>4s}")
+    print(
+        f"\nsearch with the optional terms: {terms_search['candidates']} candidates in {terms_seconds:.1f} s; "
+        f"the 12 best settings (fitting poses):"
+    )
+    print(
+        f"{'trunk r':>7s} {'leg r':>5s} {'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} {'fwd':>5s} "
+        f"{'foothold r/search/spread':>24s} {'sens %':>6s} {'spec %':>6s} {'met':>4s}"
+    )
     for row in sorted(terms_search["table"], key=rank)[:12]:
-        foot = ("off" if row["foothold_spread"] is None else
-                f"{row['foothold_radius']:.3f}/{row['foothold_search']:.2f}/{row['foothold_spread']:.3f}")
-        print(f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
-              f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {row['leg_forward']:5.2f} {foot:>24s} "
-              f"{100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}")
-    print(f"\nsearch with the hands term on that setting: {hands_search['candidates']} candidates in "
-          f"{hands_seconds:.1f} s; best per hand radius and bottom (fitting poses):")
-    print(f"{'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} {'hand r':>6s} {'hand bot':>8s} "
-          f"{'sens %':>6s} {'spec %':>6s} {'met':>4s}")
+        foot = (
+            "off"
+            if row["foothold_spread"] is None
+            else f"{row['foothold_radius']:.3f}/{row['foothold_search']:.2f}/{row['foothold_spread']:.3f}"
+        )
+        print(
+            f"{row['trunk_radius']:7.2f} {row['leg_radius']:5.2f} {row['trunk_bottom']:9.3f} "
+            f"{row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {row['leg_forward']:5.2f} {foot:>24s} "
+            f"{100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} {'yes' if row['met'] else 'no':>4s}"
+        )
+    print(
+        f"\nsearch with the hands term on that setting: {hands_search['candidates']} candidates in "
+        f"{hands_seconds:.1f} s; best per hand radius and bottom (fitting poses):"
+    )
+    print(
+        f"{'trunk bot':>9s} {'leg bot':>7s} {'leg top':>7s} {'hand r':>6s} {'hand bot':>8s} "
+        f"{'sens %':>6s} {'spec %':>6s} {'met':>4s}"
+    )
     for row in hands_search["table"]:
-        hand = ("   off", "     -") if row["hand_radius"] is None else (f"{row['hand_radius']:6.2f}",
-                                                                        f"{row['hand_bottom']:8.2f}")
-        print(f"{row['trunk_bottom']:9.3f} {row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {hand[0]:>6s} "
-              f"{hand[1]:>8s} {100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} "
-              f"{'yes' if row['met'] else 'no':>4s}")
+        hand = (
+            ("   off", "     -")
+            if row["hand_radius"] is None
+            else (f"{row['hand_radius']:6.2f}", f"{row['hand_bottom']:8.2f}")
+        )
+        print(
+            f"{row['trunk_bottom']:9.3f} {row['leg_bottom']:7.3f} {row['leg_top']:7.3f} {hand[0]:>6s} "
+            f"{hand[1]:>8s} {100 * row['sensitivity']:6.1f} {100 * row['specificity']:6.1f} "
+            f"{'yes' if row['met'] else 'no':>4s}"
+        )
     print()
-    for name, cfg, fig in (("old (DESIGN §5)", old, old_figures), ("new (cylinders only)", new, new_figures),
-                           ("new with the optional terms", with_terms, terms_figures),
-                           ("new with the optional terms and the hands", with_hands, hands_figures),
-                           ("current EnvConfig defaults", current, current_figures),
-                           ("training presets (TRAINING_REACHABILITY)", TRAINING_REACHABILITY, training_figures)):
+    for name, cfg, fig in (
+        ("old (docs/design.md §5)", old, old_figures),
+        ("new (cylinders only)", new, new_figures),
+        ("new with the optional terms", with_terms, terms_figures),
+        ("new with the optional terms and the hands", with_hands, hands_figures),
+        ("current EnvConfig defaults", current, current_figures),
+        ("training presets (TRAINING_REACHABILITY)", TRAINING_REACHABILITY, training_figures),
+    ):
         print(f"{name}: {_describe(cfg)}")
         for part in ("all", "fit", "held_out"):
             print(f"  {part:9s} {_fmt(fig[part])}")
-    for name, result in (("cylinders only", search), ("with the optional terms", terms_search),
-                         ("with the optional terms and the hands", hands_search)):
-        print(f"{name}: targets (sens >= {100 * TARGET_SENSITIVITY:.0f} %, spec >= {100 * TARGET_SPECIFICITY:.0f} %) "
-              f"{'met' if result['met'] else 'NOT met'} on the fitting poses (sensitivity target "
-              f"{'met' if result['sensitive'] else 'NOT met'})")
+    for name, result in (
+        ("cylinders only", search),
+        ("with the optional terms", terms_search),
+        ("with the optional terms and the hands", hands_search),
+    ):
+        print(
+            f"{name}: targets (sens >= {100 * TARGET_SENSITIVITY:.0f} %, spec >= {100 * TARGET_SPECIFICITY:.0f} %) "
+            f"{'met' if result['met'] else 'NOT met'} on the fitting poses (sensitivity target "
+            f"{'met' if result['sensitive'] else 'NOT met'})"
+        )
     print(f"jitted/NumPy mismatches: {mismatch}")
 
     as_dict = lambda c: dataclasses.asdict(c)  # noqa: E731
-    save(f"reachability_calibration{suffix}", {"truth": args.truth,
-        "terrain": str(Path(args.terrain).resolve().relative_to(REPO)) if Path(args.terrain).resolve().is_relative_to(REPO)
-        else args.terrain,
-        "poses": len(poses), "feasible": int(truth.sum()), "seed": args.seed, "workers": args.workers,
-        "ground_truth_seconds": gt_seconds, "search_seconds": search_seconds, "terms_search_seconds": terms_seconds,
-        "hands_search_seconds": hands_seconds,
-        "sampling": {"z_offsets_m": Z_OFFSETS, "near_obstacle_fraction": NEAR_FRACTION,
-                     "reference": f"highest terrain point within {REFERENCE_RADIUS} m", "nominal_m": 1.0},
-        "targets": {"sensitivity": TARGET_SENSITIVITY, "specificity": TARGET_SPECIFICITY},
-        "flat_ground_constraint": {"heights_m": FLAT_HEIGHTS, "margin_m": FLAT_MARGIN},
-        "grid": {k: list(map(float, v)) for k, v in GRID.items()}, "candidates": search["candidates"],
-        "terms_grid": {k: list(v) for k, v in TERMS_GRID.items()}, "terms_candidates": terms_search["candidates"],
-        "hands_grid": {k: list(v) for k, v in HANDS_GRID.items()}, "hands_candidates": hands_search["candidates"],
-        "targets_met_on_fit": search["met"], "sensitivity_target_met_on_fit": search["sensitive"],
-        "terms_targets_met_on_fit": terms_search["met"],
-        "terms_sensitivity_target_met_on_fit": terms_search["sensitive"],
-        "hands_targets_met_on_fit": hands_search["met"],
-        "hands_sensitivity_target_met_on_fit": hands_search["sensitive"],
-        "chosen": as_dict(new), "chosen_with_terms": as_dict(with_terms), "chosen_with_hands": as_dict(with_hands),
-        "old": as_dict(old),
-        "current": as_dict(current), "training": as_dict(TRAINING_REACHABILITY),
-        "figures": {"old": old_figures, "new": new_figures, "new_with_terms": terms_figures,
-                    "new_with_hands": hands_figures, "current": current_figures, "training": training_figures},
-        "by_height_offset": {"old": breakdown(poses, truth, old_pred, terrain),
-                             "new": breakdown(poses, truth, new_pred, terrain),
-                             "new_with_terms": breakdown(poses, truth, terms_pred, terrain),
-                             "new_with_hands": breakdown(poses, truth, hands_pred, terrain),
-                             "current": breakdown(poses, truth, current_pred, terrain)},
-        "best_per_radius_pair": search["table"], "best_per_terms_setting": terms_search["table"],
-        "best_per_hands_setting": hands_search["table"],
-        "jit_numpy_mismatches": mismatch,
-    })
+    save(
+        f"reachability_calibration{suffix}",
+        {
+            "truth": args.truth,
+            "terrain": str(Path(args.terrain).resolve().relative_to(REPO))
+            if Path(args.terrain).resolve().is_relative_to(REPO)
+            else args.terrain,
+            "poses": len(poses),
+            "feasible": int(truth.sum()),
+            "seed": args.seed,
+            "workers": args.workers,
+            "ground_truth_seconds": gt_seconds,
+            "search_seconds": search_seconds,
+            "terms_search_seconds": terms_seconds,
+            "hands_search_seconds": hands_seconds,
+            "sampling": {
+                "z_offsets_m": Z_OFFSETS,
+                "near_obstacle_fraction": NEAR_FRACTION,
+                "reference": f"highest terrain point within {REFERENCE_RADIUS} m",
+                "nominal_m": 1.0,
+            },
+            "targets": {"sensitivity": TARGET_SENSITIVITY, "specificity": TARGET_SPECIFICITY},
+            "flat_ground_constraint": {"heights_m": FLAT_HEIGHTS, "margin_m": FLAT_MARGIN},
+            "grid": {k: list(map(float, v)) for k, v in GRID.items()},
+            "candidates": search["candidates"],
+            "terms_grid": {k: list(v) for k, v in TERMS_GRID.items()},
+            "terms_candidates": terms_search["candidates"],
+            "hands_grid": {k: list(v) for k, v in HANDS_GRID.items()},
+            "hands_candidates": hands_search["candidates"],
+            "targets_met_on_fit": search["met"],
+            "sensitivity_target_met_on_fit": search["sensitive"],
+            "terms_targets_met_on_fit": terms_search["met"],
+            "terms_sensitivity_target_met_on_fit": terms_search["sensitive"],
+            "hands_targets_met_on_fit": hands_search["met"],
+            "hands_sensitivity_target_met_on_fit": hands_search["sensitive"],
+            "chosen": as_dict(new),
+            "chosen_with_terms": as_dict(with_terms),
+            "chosen_with_hands": as_dict(with_hands),
+            "old": as_dict(old),
+            "current": as_dict(current),
+            "training": as_dict(TRAINING_REACHABILITY),
+            "figures": {
+                "old": old_figures,
+                "new": new_figures,
+                "new_with_terms": terms_figures,
+                "new_with_hands": hands_figures,
+                "current": current_figures,
+                "training": training_figures,
+            },
+            "by_height_offset": {
+                "old": breakdown(poses, truth, old_pred, terrain),
+                "new": breakdown(poses, truth, new_pred, terrain),
+                "new_with_terms": breakdown(poses, truth, terms_pred, terrain),
+                "new_with_hands": breakdown(poses, truth, hands_pred, terrain),
+                "current": breakdown(poses, truth, current_pred, terrain),
+            },
+            "best_per_radius_pair": search["table"],
+            "best_per_terms_setting": terms_search["table"],
+            "best_per_hands_setting": hands_search["table"],
+            "jit_numpy_mismatches": mismatch,
+        },
+    )
 
 
 if __name__ == "__main__":

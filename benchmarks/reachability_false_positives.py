@@ -95,8 +95,10 @@ def features(terrain, poses: np.ndarray, config) -> dict:
 
     z, yaw = poses[:, 2], poses[:, 3]
     side = np.column_stack([-np.sin(yaw), np.cos(yaw)])
-    legs = np.stack([poses[:, :2] + config.leg_lateral_offset * side,
-                     poses[:, :2] - config.leg_lateral_offset * side], axis=1)  # [N, 2 legs, 2]
+    legs = np.stack(
+        [poses[:, :2] + config.leg_lateral_offset * side, poses[:, :2] - config.leg_lateral_offset * side],
+        axis=1,
+    )  # [N, 2 legs, 2]
     reference = disk_filter(heights, rc.REFERENCE_RADIUS / res, "max", void)
     leg_highest = disk_filter(_solid(heights, void, -np.inf), config.leg_radius / res, "max", -np.inf)
     sole_highest = disk_filter(_solid(heights, void, np.inf), SOLE_RADIUS / res, "max", np.inf)
@@ -143,13 +145,14 @@ def _outcome_chunk(poses: np.ndarray) -> np.ndarray:
 
 def generator_outcomes(terrain, poses: np.ndarray, workers: int = 2, chunk: int = 50) -> np.ndarray:
     """[N, 2] (last_valid_index, posture_failed) of the walking plans from poses [N, 4]."""
-    parts = [poses[k:k + chunk] for k in range(0, len(poses), chunk)]
+    parts = [poses[k : k + chunk] for k in range(0, len(poses), chunk)]
     if workers <= 1:
         rc._init_worker(terrain.text)
         results = [_outcome_chunk(p) for p in parts]
     else:
-        with multiprocessing.get_context("spawn").Pool(workers, initializer=rc._init_worker,
-                                                       initargs=(terrain.text,)) as pool:
+        with multiprocessing.get_context("spawn").Pool(
+            workers, initializer=rc._init_worker, initargs=(terrain.text,)
+        ) as pool:
             results = pool.map(_outcome_chunk, parts)
     return np.concatenate(results) if results else np.zeros((0, 2), dtype=np.int64)
 
@@ -174,12 +177,15 @@ def _band_rows(values: np.ndarray, edges, fp: np.ndarray, tp: np.ndarray) -> lis
     rows = []
     for lo, hi in zip(edges[:-1], edges[1:]):
         band = (values >= lo) & (values < hi)
-        rows.append({"from": float(lo), "to": float(hi), "fp": int((band & fp).sum()), "tp": int((band & tp).sum())})
+        rows.append(
+            {"from": float(lo), "to": float(hi), "fp": int((band & fp).sum()), "tp": int((band & tp).sum())}
+        )
     return rows
 
 
 def main(argv=None) -> None:
     from common import save
+
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
 
@@ -204,8 +210,10 @@ def main(argv=None) -> None:
     ahead = valid_ahead(terrain, poses, config)
     cls = classify(f, ahead)
     print(f"{len(poses)} poses, truth {args.truth}, condition {rc._describe(config)}")
-    print(f"sensitivity {100 * figures['sensitivity']:.1f} %, specificity {100 * figures['specificity']:.1f} %: "
-          f"{figures['fp']} false positives, {figures['tp']} true positives\n")
+    print(
+        f"sensitivity {100 * figures['sensitivity']:.1f} %, specificity {100 * figures['specificity']:.1f} %: "
+        f"{figures['fp']} false positives, {figures['tp']} true positives\n"
+    )
 
     print(f"{'class (first match)':20s} {'FP':>5s} {'TP':>5s}  {'FP share':>8s}  description")
     class_rows = []
@@ -217,13 +225,19 @@ def main(argv=None) -> None:
     outcome_rows, outcomes = [], None
     if not args.no_generator:
         outcomes = generator_outcomes(terrain, poses[fp], args.workers)
-        labels = np.where(outcomes[:, 0] >= 0,
-                          np.char.add("stops after ", (np.maximum(outcomes[:, 0], 0) * rc.WALK_SPEED
-                                                       * rc.WALK_TIMESTEP).round(2).astype(str)),
-                          np.where(outcomes[:, 1] == 1, "cannot stand: posture", "cannot stand: no foothold"))
+        labels = np.where(
+            outcomes[:, 0] >= 0,
+            np.char.add(
+                "stops after ",
+                (np.maximum(outcomes[:, 0], 0) * rc.WALK_SPEED * rc.WALK_TIMESTEP).round(2).astype(str),
+            ),
+            np.where(outcomes[:, 1] == 1, "cannot stand: posture", "cannot stand: no foothold"),
+        )
         names = [name for name, _ in CLASSES]
-        print(f"\ngenerator outcome of the FPs (rows; plan stops after that many m of the 0.36 m guide) "
-              f"by class (columns):")
+        print(
+            "\ngenerator outcome of the FPs (rows; plan stops after that many m of the 0.36 m guide) "
+            "by class (columns):"
+        )
         print(f"{'outcome':26s} {'FP':>5s} " + " ".join(f"{n[:10]:>10s}" for n in names))
         for label in sorted(set(labels.tolist())):
             sel = labels == label
@@ -243,32 +257,63 @@ def main(argv=None) -> None:
     bands = {
         "offset_m": (f["offset"], np.round(np.arange(-0.25, 0.2501, 0.05), 3)),
         "leg_clearance_m": (f["leg_clearance"], np.round(np.arange(0.80, 1.2001, 0.05), 3)),
-        "leg_spread_m": (np.nan_to_num(f["leg_spread"], posinf=9.0), np.array([0, 0.005, 0.02, 0.05, 0.1, 0.3, 10])),
+        "leg_spread_m": (
+            np.nan_to_num(f["leg_spread"], posinf=9.0),
+            np.array([0, 0.005, 0.02, 0.05, 0.1, 0.3, 10]),
+        ),
         "edge_distance_m": (f["edge_distance"], np.array([0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 30])),
     }
     band_rows = {}
     for name, (values, edges) in bands.items():
         band_rows[name] = _band_rows(values, edges, fp, tp)
-        print(f"\nby {name}: " + ", ".join(f"[{r['from']:g}, {r['to']:g}) FP {r['fp']} TP {r['tp']}"
-                                         for r in band_rows[name]))
-    facing = {"near_edge_facing": {"fp": int((fp & f["facing_edge"] & (f["edge_distance"] < 0.5)).sum()),
-                                   "tp": int((tp & f["facing_edge"] & (f["edge_distance"] < 0.5)).sum())},
-              "near_edge_not_facing": {"fp": int((fp & ~f["facing_edge"] & (f["edge_distance"] < 0.5)).sum()),
-                                       "tp": int((tp & ~f["facing_edge"] & (f["edge_distance"] < 0.5)).sum())}}
-    print(f"\nwithin 0.5 m of an edge: heading at it (45 deg) FP {facing['near_edge_facing']['fp']} "
-          f"TP {facing['near_edge_facing']['tp']}; not FP {facing['near_edge_not_facing']['fp']} "
-          f"TP {facing['near_edge_not_facing']['tp']}")
-    print(f"condition valid along the whole guide: FP {int((fp & ahead).sum())} of {int(fp.sum())}, "
-          f"TP {int((tp & ahead).sum())} of {int(tp.sum())}")
+        print(
+            f"\nby {name}: "
+            + ", ".join(f"[{r['from']:g}, {r['to']:g}) FP {r['fp']} TP {r['tp']}" for r in band_rows[name])
+        )
+    facing = {
+        "near_edge_facing": {
+            "fp": int((fp & f["facing_edge"] & (f["edge_distance"] < 0.5)).sum()),
+            "tp": int((tp & f["facing_edge"] & (f["edge_distance"] < 0.5)).sum()),
+        },
+        "near_edge_not_facing": {
+            "fp": int((fp & ~f["facing_edge"] & (f["edge_distance"] < 0.5)).sum()),
+            "tp": int((tp & ~f["facing_edge"] & (f["edge_distance"] < 0.5)).sum()),
+        },
+    }
+    print(
+        f"\nwithin 0.5 m of an edge: heading at it (45 deg) FP {facing['near_edge_facing']['fp']} "
+        f"TP {facing['near_edge_facing']['tp']}; not FP {facing['near_edge_not_facing']['fp']} "
+        f"TP {facing['near_edge_not_facing']['tp']}"
+    )
+    print(
+        f"condition valid along the whole guide: FP {int((fp & ahead).sum())} of {int(fp.sum())}, "
+        f"TP {int((tp & ahead).sum())} of {int(tp.sum())}"
+    )
 
-    save(f"reachability_false_positives_{args.truth}", {
-        "truth": args.truth, "poses": len(poses), "seed": args.seed, "config": dataclasses.asdict(config),
-        "figures": figures, "thresholds": {"sole_radius_m": SOLE_RADIUS, "edge_jump_m": EDGE_JUMP,
-                                           "near_edge_m": NEAR_EDGE, "low_offset_m": LOW_OFFSET,
-                                           "high_offset_m": HIGH_OFFSET, "uneven_m": UNEVEN},
-        "classes": class_rows, "generator_outcomes": outcome_rows, "by_kind": kind_rows, "bands": band_rows,
-        "edge_heading": facing, "valid_along_guide": {"fp": int((fp & ahead).sum()), "tp": int((tp & ahead).sum())},
-    })
+    save(
+        f"reachability_false_positives_{args.truth}",
+        {
+            "truth": args.truth,
+            "poses": len(poses),
+            "seed": args.seed,
+            "config": dataclasses.asdict(config),
+            "figures": figures,
+            "thresholds": {
+                "sole_radius_m": SOLE_RADIUS,
+                "edge_jump_m": EDGE_JUMP,
+                "near_edge_m": NEAR_EDGE,
+                "low_offset_m": LOW_OFFSET,
+                "high_offset_m": HIGH_OFFSET,
+                "uneven_m": UNEVEN,
+            },
+            "classes": class_rows,
+            "generator_outcomes": outcome_rows,
+            "by_kind": kind_rows,
+            "bands": band_rows,
+            "edge_heading": facing,
+            "valid_along_guide": {"fp": int((fp & ahead).sum()), "tp": int((tp & ahead).sum())},
+        },
+    )
 
 
 if __name__ == "__main__":

@@ -73,12 +73,21 @@ def wilson(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
 def rates(predicted: np.ndarray, truth: np.ndarray) -> dict:
     """`reachability_calibration.confusion` plus the Wilson intervals of both rates."""
     c = rc.confusion(predicted, truth)
-    return {**c, "sensitivity_95ci": wilson(c["tp"], c["tp"] + c["fn"]),
-            "specificity_95ci": wilson(c["tn"], c["tn"] + c["fp"])}
+    return {
+        **c,
+        "sensitivity_95ci": wilson(c["tp"], c["tp"] + c["fn"]),
+        "specificity_95ci": wilson(c["tn"], c["tn"] + c["fp"]),
+    }
 
 
-def local_heightmap(terrain, poses: np.ndarray, step: float = HEIGHTMAP_STEP, x_range=HEIGHTMAP_X,
-                    y_range=HEIGHTMAP_Y, clip=HEIGHTMAP_CLIP) -> np.ndarray:
+def local_heightmap(
+    terrain,
+    poses: np.ndarray,
+    step: float = HEIGHTMAP_STEP,
+    x_range=HEIGHTMAP_X,
+    y_range=HEIGHTMAP_Y,
+    clip=HEIGHTMAP_CLIP,
+) -> np.ndarray:
     """Terrain heights around each root, in its frame (nearest raster cell, host NumPy).
 
     Args:
@@ -103,13 +112,23 @@ def local_heightmap(terrain, poses: np.ndarray, step: float = HEIGHTMAP_STEP, x_
     i = np.round((wx - x0) / res).astype(np.int64)
     j = np.round((wy - y0) / res).astype(np.int64)
     inside = (i >= 0) & (i < heights.shape[0]) & (j >= 0) & (j < heights.shape[1])
-    z = np.where(inside, heights[np.clip(i, 0, heights.shape[0] - 1), np.clip(j, 0, heights.shape[1] - 1)],
-                 terrain.void_height)
+    z = np.where(
+        inside,
+        heights[np.clip(i, 0, heights.shape[0] - 1), np.clip(j, 0, heights.shape[1] - 1)],
+        terrain.void_height,
+    )
     return np.clip(z - poses[:, 2:3], *clip).astype(np.float32)
 
 
-def learned_reference(train_x: np.ndarray, train_y: np.ndarray, test_x: np.ndarray, test_y: np.ndarray,
-                      sizes, seed: int = 0, target: float = TARGET_SENSITIVITY) -> list[dict]:
+def learned_reference(
+    train_x: np.ndarray,
+    train_y: np.ndarray,
+    test_x: np.ndarray,
+    test_y: np.ndarray,
+    sizes,
+    seed: int = 0,
+    target: float = TARGET_SENSITIVITY,
+) -> list[dict]:
     """Gradient-boosted trees fitted on growing prefixes of a training set, tested on another.
 
     Args:
@@ -132,9 +151,15 @@ def learned_reference(train_x: np.ndarray, train_y: np.ndarray, test_x: np.ndarr
         if size > len(train_x):
             raise ValueError(f"--train-sizes: {size} exceeds the {len(train_x)} fitting poses")
         aside = max(1, int(round(THRESHOLD_SPLIT * size)))
-        model = HistGradientBoostingClassifier(max_iter=1500, learning_rate=0.08, max_leaf_nodes=31,
-                                               l2_regularization=1.0, early_stopping=True,
-                                               validation_fraction=0.1, random_state=seed)
+        model = HistGradientBoostingClassifier(
+            max_iter=1500,
+            learning_rate=0.08,
+            max_leaf_nodes=31,
+            l2_regularization=1.0,
+            early_stopping=True,
+            validation_fraction=0.1,
+            random_state=seed,
+        )
         start = time.perf_counter()
         model.fit(train_x[aside:size], train_y[aside:size])
         seconds = time.perf_counter() - start
@@ -145,22 +170,33 @@ def learned_reference(train_x: np.ndarray, train_y: np.ndarray, test_x: np.ndarr
         threshold = float(np.quantile(aside_feasible, 1.0 - target))
         test_p = model.predict_proba(test_x)[:, 1]
         oracle = float(np.quantile(test_p[test_y], 1.0 - target))
-        rows.append({"poses": int(size), "fitted": int(size - aside), "threshold_poses": aside,
-                     "iterations": int(model.n_iter_), "fit_seconds": seconds, "threshold": threshold,
-                     "test": rates(test_p >= threshold, test_y),
-                     "specificity_at_target": float(np.mean(test_p[~test_y] < oracle))})
+        rows.append(
+            {
+                "poses": int(size),
+                "fitted": int(size - aside),
+                "threshold_poses": aside,
+                "iterations": int(model.n_iter_),
+                "fit_seconds": seconds,
+                "threshold": threshold,
+                "test": rates(test_p >= threshold, test_y),
+                "specificity_at_target": float(np.mean(test_p[~test_y] < oracle)),
+            }
+        )
     return rows
 
 
 def _fmt(c: dict) -> str:
     (slo, shi), (plo, phi) = c["sensitivity_95ci"], c["specificity_95ci"]
-    return (f"sens {100 * c['sensitivity']:5.1f} % [{100 * slo:4.1f}, {100 * shi:4.1f}]  "
-            f"spec {100 * c['specificity']:5.1f} % [{100 * plo:4.1f}, {100 * phi:4.1f}]  "
-            f"(tp {c['tp']}, fn {c['fn']}, fp {c['fp']}, tn {c['tn']})")
+    return (
+        f"sens {100 * c['sensitivity']:5.1f} % [{100 * slo:4.1f}, {100 * shi:4.1f}]  "
+        f"spec {100 * c['specificity']:5.1f} % [{100 * plo:4.1f}, {100 * phi:4.1f}]  "
+        f"(tp {c['tp']}, fn {c['fn']}, fp {c['fp']}, tn {c['tn']})"
+    )
 
 
 def main(argv=None) -> None:
     from common import save
+
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import TRAINING_REACHABILITY
@@ -171,13 +207,23 @@ def main(argv=None) -> None:
     parser.add_argument("--truth", nargs="+", choices=("static", "walking"), default=["static", "walking"])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--reuse", action="store_true", help="reuse cached ground truths when they match")
-    parser.add_argument("--calibration-json", default=None,
-                        help="a reachability_calibration JSON: also validate its chosen_with_hands setting")
+    parser.add_argument(
+        "--calibration-json",
+        default=None,
+        help="a reachability_calibration JSON: also validate its chosen_with_hands setting",
+    )
     parser.add_argument("--learned", action="store_true", help="fit the learned reference (scikit-learn)")
-    parser.add_argument("--train-sizes", default="8000,18000,36000",
-                        help="comma-separated training set sizes of the learned reference")
-    parser.add_argument("--calibration-poses", type=int, default=48000,
-                        help="the calibration's pose count (seed 0): the learned reference's test set")
+    parser.add_argument(
+        "--train-sizes",
+        default="8000,18000,36000",
+        help="comma-separated training set sizes of the learned reference",
+    )
+    parser.add_argument(
+        "--calibration-poses",
+        type=int,
+        default=48000,
+        help="the calibration's pose count (seed 0): the learned reference's test set",
+    )
     args = parser.parse_args(argv)
     if args.seed == CALIBRATION_SEED:
         parser.error("--seed 0 draws the calibration's own poses; validate on another seed")
@@ -205,30 +251,50 @@ def main(argv=None) -> None:
         train_x = local_heightmap(terrain, poses[order])
         test_poses = rc.sample_poses(terrain, args.calibration_poses, CALIBRATION_SEED)
         test_x = local_heightmap(terrain, test_poses)
-    report = {"poses": args.poses, "seed": args.seed, "terrain": f"terrains/{rc.ARENA.name}",
-              "configs": {name: dataclasses.asdict(cfg) for name, cfg in configs.items()}, "truths": {}}
+    report = {
+        "poses": args.poses,
+        "seed": args.seed,
+        "terrain": f"terrains/{rc.ARENA.name}",
+        "configs": {name: dataclasses.asdict(cfg) for name, cfg in configs.items()},
+        "truths": {},
+    }
     for truth_name in args.truth:
-        truth, seconds = rc.cached_ground_truth(terrain, poses, truth_name, args.workers, args.reuse, args.seed)
-        print(f"\n{truth_name} truth: {len(poses)} fresh poses (seed {args.seed}), {int(truth.sum())} feasible, "
-              f"{seconds:.0f} s with {args.workers} workers")
+        truth, seconds = rc.cached_ground_truth(
+            terrain, poses, truth_name, args.workers, args.reuse, args.seed
+        )
+        print(
+            f"\n{truth_name} truth: {len(poses)} fresh poses (seed {args.seed}), {int(truth.sum())} feasible, "
+            f"{seconds:.0f} s with {args.workers} workers"
+        )
         entry = {"feasible": int(truth.sum()), "ground_truth_seconds": seconds, "validation": {}}
         for name, cfg in configs.items():
             entry["validation"][name] = rates(rc.condition(terrain, poses, cfg), truth)
             print(f"  {name:40s} {_fmt(entry['validation'][name])}")
         if args.learned:
-            test_truth, _ = rc.cached_ground_truth(terrain, test_poses, truth_name, args.workers, args.reuse,
-                                                   CALIBRATION_SEED)
+            test_truth, _ = rc.cached_ground_truth(
+                terrain, test_poses, truth_name, args.workers, args.reuse, CALIBRATION_SEED
+            )
             rows = learned_reference(train_x, truth[order], test_x, test_truth, sizes)
             test_set = f"the calibration's {len(test_poses)} poses (seed {CALIBRATION_SEED})"
-            entry["learned_reference"] = {"test": test_set,
-                                          "heightmap": {"step_m": HEIGHTMAP_STEP, "x_m": HEIGHTMAP_X,
-                                                        "y_m": HEIGHTMAP_Y, "clip_m": HEIGHTMAP_CLIP},
-                                          "rows": rows}
-            print(f"  learned reference (gradient-boosted trees on a {HEIGHTMAP_STEP} m root-frame heightmap), "
-                  f"tested on the calibration's {len(test_poses)} poses:")
+            entry["learned_reference"] = {
+                "test": test_set,
+                "heightmap": {
+                    "step_m": HEIGHTMAP_STEP,
+                    "x_m": HEIGHTMAP_X,
+                    "y_m": HEIGHTMAP_Y,
+                    "clip_m": HEIGHTMAP_CLIP,
+                },
+                "rows": rows,
+            }
+            print(
+                f"  learned reference (gradient-boosted trees on a {HEIGHTMAP_STEP} m root-frame heightmap), "
+                f"tested on the calibration's {len(test_poses)} poses:"
+            )
             for row in rows:
-                print(f"    {row['poses']:6d} training poses: {_fmt(row['test'])}; specificity at "
-                      f"{100 * TARGET_SENSITIVITY:.0f} % test sensitivity {100 * row['specificity_at_target']:5.1f} %")
+                print(
+                    f"    {row['poses']:6d} training poses: {_fmt(row['test'])}; specificity at "
+                    f"{100 * TARGET_SENSITIVITY:.0f} % test sensitivity {100 * row['specificity_at_target']:5.1f} %"
+                )
         report["truths"][truth_name] = entry
     save("reachability_validation", report)
 

@@ -17,7 +17,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import jax  # noqa: E402
-
 from common import save  # noqa: E402
 
 
@@ -38,13 +37,21 @@ def measure(config, field, calls: int) -> dict:
     run_s = time.perf_counter() - t0
     load_after = os.getloadavg()[0]
     steps = calls * config.iterations_per_call * config.batch_size
-    return {"preset": config.preset, "num_envs": config.num_envs, "unroll_length": config.unroll_length,
-            "num_minibatches": config.num_minibatches, "num_epochs": config.num_epochs,
-            "compile_s": round(compile_s, 2), "run_s": round(run_s, 3), "env_steps": steps,
-            "env_steps_per_s": round(steps / run_s),
-            "minutes_for_80M_steps": round(80e6 / (steps / run_s) / 60, 1),
-            # 1-minute load average before and after the timed calls: other jobs on the machine slow it down
-            "load_average_1min": [round(load_before, 2), round(load_after, 2)], "cpus": os.cpu_count()}
+    return {
+        "preset": config.preset,
+        "num_envs": config.num_envs,
+        "unroll_length": config.unroll_length,
+        "num_minibatches": config.num_minibatches,
+        "num_epochs": config.num_epochs,
+        "compile_s": round(compile_s, 2),
+        "run_s": round(run_s, 3),
+        "env_steps": steps,
+        "env_steps_per_s": round(steps / run_s),
+        "minutes_for_80M_steps": round(80e6 / (steps / run_s) / 60, 1),
+        # 1-minute load average before and after the timed calls: other jobs on the machine slow it down
+        "load_average_1min": [round(load_before, 2), round(load_after, 2)],
+        "cpus": os.cpu_count(),
+    }
 
 
 def main() -> None:
@@ -65,10 +72,13 @@ def main() -> None:
         for variant in variants:
             row = measure(variant, field, args.calls)
             rows.append(row)
-            print(f"{name:6s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
-                  f"{row['env_steps_per_s']:>10,} env steps/s, 80 M steps in {row['minutes_for_80M_steps']} min "
-                  f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
-                  f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)", flush=True)
+            print(
+                f"{name:6s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
+                f"{row['env_steps_per_s']:>10,} env steps/s, 80 M steps in {row['minutes_for_80M_steps']} min "
+                f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
+                f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)",
+                flush=True,
+            )
     save("train_throughput", {"rows": rows})
 
 

@@ -31,8 +31,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import save  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-CASES = {"flat": ("terrains/eval_ground.toml", 3.0, 4.0, 0.0),  # terrain, x0, y0, radius override (0: under the root)
-         "stairs": ("terrains/eval_stairs.toml", 2.5, 3.0, None)}
+CASES = {
+    "flat": (
+        "terrains/eval_ground.toml",
+        3.0,
+        4.0,
+        0.0,
+    ),  # terrain, x0, y0, radius override (0: under the root)
+    "stairs": ("terrains/eval_stairs.toml", 2.5, 3.0, None),
+}
 POSES = 200
 LENGTH_M = 3.6
 
@@ -42,7 +49,9 @@ def highest_ground(terrain, xy: np.ndarray, radius: float) -> np.ndarray:
     if radius <= 0:
         return terrain.height_at(xy)
     grid = np.linspace(-radius, radius, 7)
-    offsets = np.array([(dx, dy) for dx in grid for dy in grid if dx * dx + dy * dy <= radius * radius + 1e-12])
+    offsets = np.array(
+        [(dx, dy) for dx in grid for dy in grid if dx * dx + dy * dy <= radius * radius + 1e-12]
+    )
     return np.array([terrain.height_at(p + offsets).max() for p in xy])
 
 
@@ -55,15 +64,20 @@ def straight_guide(terrain, x0: float, y0: float, height: float, radius: float) 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--heights", default="0.80,0.85,0.90,0.95,1.00,1.05,1.10,1.15",
-                        help="root heights above the ground, m (comma-separated)")
-    parser.add_argument("--radius", type=float, default=0.15, help="stairs: ground = highest within this radius, m")
+    parser.add_argument(
+        "--heights",
+        default="0.80,0.85,0.90,0.95,1.00,1.05,1.10,1.15",
+        help="root heights above the ground, m (comma-separated)",
+    )
+    parser.add_argument(
+        "--radius", type=float, default=0.15, help="stairs: ground = highest within this radius, m"
+    )
     args = parser.parse_args(argv)
     heights = [float(h) for h in args.heights.split(",")]
 
     import jax
 
-    from leas_jax.contacts.generator import plan_contacts
+    from leas_jax.contacts.planner.generator import plan_contacts
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.env.reachability import valid
     from leas_jax.terrain import load_terrain
@@ -78,15 +92,29 @@ def main(argv=None) -> int:
             guide = straight_guide(terrain, x0, y0, height, args.radius if radius is None else radius)
             plan = plan_contacts(terrain, guide, env.timestep)
             condition = np.asarray(check(field, guide.astype(np.float32), env.reachability))
-            row = {"case": case, "height_m": height, "coverage": round(float(plan.coverage), 4),
-                   "last_valid_x_m": round(float(guide[max(plan.last_valid_index, 0), 0]), 3),
-                   "condition_valid_fraction": round(float(condition.mean()), 4)}
+            row = {
+                "case": case,
+                "height_m": height,
+                "coverage": round(float(plan.coverage), 4),
+                "last_valid_x_m": round(float(guide[max(plan.last_valid_index, 0), 0]), 3),
+                "condition_valid_fraction": round(float(condition.mean()), 4),
+            }
             rows.append(row)
-            print(f"{case:7s} h {height:.2f} m: generator coverage {row['coverage']:.3f} "
-                  f"(stops at x {row['last_valid_x_m']:.2f}), reachability condition valid on "
-                  f"{row['condition_valid_fraction']:.0%} of the poses")
-    save("walking_height", {"poses_per_guide": POSES, "length_m": LENGTH_M, "stairs_radius_m": args.radius,
-                            "reachability": env.reachability.__dict__, "rows": rows})
+            print(
+                f"{case:7s} h {height:.2f} m: generator coverage {row['coverage']:.3f} "
+                f"(stops at x {row['last_valid_x_m']:.2f}), reachability condition valid on "
+                f"{row['condition_valid_fraction']:.0%} of the poses"
+            )
+    save(
+        "walking_height",
+        {
+            "poses_per_guide": POSES,
+            "length_m": LENGTH_M,
+            "stairs_radius_m": args.radius,
+            "reachability": env.reachability.__dict__,
+            "rows": rows,
+        },
+    )
     return 0
 
 

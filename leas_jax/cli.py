@@ -14,13 +14,17 @@ import sys
 from leas_jax.errors import LeasError
 
 
-
 def add_ray_address_argument(parser, use: str) -> None:
     """`--ray-address` of the commands that run the contact generator; `use` says what runs on Ray."""
-    parser.add_argument("--ray-address", metavar="ADDRESS", default=None,
-                        help=f"{use} on Ray instead of local processes (pip install 'leas-jax[cluster]'): "
-                             "ray://HOST:PORT (Ray client of a cluster), auto (the cluster this machine belongs "
-                             "to) or local (a new local Ray instance)")
+    parser.add_argument(
+        "--ray-address",
+        metavar="ADDRESS",
+        default=None,
+        help=f"{use} on Ray instead of local processes (pip install 'leas-jax[cluster]'): "
+        "ray://HOST:PORT (Ray client of a cluster), auto (the cluster this machine belongs "
+        "to) or local (a new local Ray instance)",
+    )
+
 
 class OneLineErrorParser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line on stderr and exit code 2 (no usage dump)."""

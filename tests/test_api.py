@@ -8,8 +8,15 @@ def test_public_api_trains_and_rolls_out(tmp_path):
     from leas_jax.training import preset
 
     terrain = load_terrain("terrains/eval_ground.toml")
-    config = preset("smoke", num_timesteps=64 * 8 * 2, num_envs=64, unroll_length=8, num_minibatches=2,
-                    num_epochs=1, iterations_per_call=2)
+    config = preset(
+        "smoke",
+        num_timesteps=64 * 8 * 2,
+        num_envs=64,
+        unroll_length=8,
+        num_minibatches=2,
+        num_epochs=1,
+        iterations_per_call=2,
+    )
     assert isinstance(config, TrainConfig)
     result = train(config, tmp_path / "run", progress=False)
     policy = load_policy(result.run_dir)

@@ -12,9 +12,21 @@ from leas_jax.terrain import load_terrain
 from leas_jax.training import load_policy
 
 
-@pytest.mark.parametrize("bearing, sector", [(0, "ahead"), (44, "ahead"), (-44, "ahead"), (46, "left"),
-                                             (134, "left"), (180, "behind"), (-170, "behind"), (-90, "right"),
-                                             (270, "right"), (359, "ahead")])
+@pytest.mark.parametrize(
+    "bearing, sector",
+    [
+        (0, "ahead"),
+        (44, "ahead"),
+        (-44, "ahead"),
+        (46, "left"),
+        (134, "left"),
+        (180, "behind"),
+        (-170, "behind"),
+        (-90, "right"),
+        (270, "right"),
+        (359, "ahead"),
+    ],
+)
 def test_bearing_sectors(bearing, sector):
     assert bearing_sector(np.array([bearing]))[0] == sector
 
@@ -46,15 +58,31 @@ def test_breakdown_counts_every_invalid_episode_once(episodes_of_a_tiny_policy):
     policy, field, episodes = episodes_of_a_tiny_policy
     breakdown = failure_breakdown(field, episodes, policy.config.env.reachability)
     invalid = int((~np.isnan(episodes.failure_poses[:, 0])).sum())
-    assert breakdown.invalid == invalid == sum(breakdown.terms.values()) == sum(breakdown.motion_bearing.values())
+    assert (
+        breakdown.invalid
+        == invalid
+        == sum(breakdown.terms.values())
+        == sum(breakdown.motion_bearing.values())
+    )
     trunk = sum(count for label, count in breakdown.terms.items() if "trunk_free" in label.split("+"))
     assert sum(breakdown.trunk_bearing.values()) == trunk
     assert breakdown.speed_quartiles == sorted(breakdown.speed_quartiles)
 
 
 def test_arena_check_writes_its_outputs(run_dir, tmp_path, capsys):
-    code = main(["arena-check", "--checkpoint", str(run_dir), "--episodes", "32", "--seeds", "0,3",
-                 "--out", str(tmp_path)])
+    code = main(
+        [
+            "arena-check",
+            "--checkpoint",
+            str(run_dir),
+            "--episodes",
+            "32",
+            "--seeds",
+            "0,3",
+            "--out",
+            str(tmp_path),
+        ]
+    )
     assert code == 0
     report = json.loads((tmp_path / "arena_check.json").read_text())
     assert sorted(report["arena"]) == ["0", "3"] and report["episodes"] == 32
@@ -62,16 +90,27 @@ def test_arena_check_writes_its_outputs(run_dir, tmp_path, capsys):
         arena = report["arena"][seed]
         assert arena["failures"]["invalid"] == round((1 - arena["valid_fraction"]) * 32)
     assert (tmp_path / "arena_failures.png").stat().st_size > 0
-    assert "episodes without an invalid pose (32 episodes, seed 3)" in (tmp_path / "arena_check.md").read_text()
+    assert (
+        "episodes without an invalid pose (32 episodes, seed 3)" in (tmp_path / "arena_check.md").read_text()
+    )
     assert "eval_ground: mean speed" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["arena-check", "--checkpoint", "nowhere", "--seeds", "a", "--out", "o"], "--seeds: expected comma-separated"),
-    (["arena-check", "--checkpoint", "nowhere", "--seeds", "-1", "--out", "o"], "integers >= 0"),
-    (["arena-check", "--checkpoint", "nowhere", "--out", "o"], "nowhere: no policy.pkl found"),
-    (["arena-check", "--checkpoint", "nowhere", "--terrain", "missing.toml", "--out", "o"], "--terrain: no such file"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (
+            ["arena-check", "--checkpoint", "nowhere", "--seeds", "a", "--out", "o"],
+            "--seeds: expected comma-separated",
+        ),
+        (["arena-check", "--checkpoint", "nowhere", "--seeds", "-1", "--out", "o"], "integers >= 0"),
+        (["arena-check", "--checkpoint", "nowhere", "--out", "o"], "nowhere: no policy.pkl found"),
+        (
+            ["arena-check", "--checkpoint", "nowhere", "--terrain", "missing.toml", "--out", "o"],
+            "--terrain: no such file",
+        ),
+    ],
+)
 def test_usage_errors_are_one_line(capsys, tmp_path, monkeypatch, argv, fragment):
     monkeypatch.chdir(tmp_path)
     code = main(argv)

@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from leas_jax.contacts.generator import ContactPosture, double_support_posture
-from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT
+from leas_jax.contacts.planner.generator import ContactPosture, double_support_posture
+from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT
 from leas_jax.env import ReachabilityConfig
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import REACHABILITY_TERMS_OFF
@@ -32,13 +32,30 @@ TERRAIN = load_terrain(Path(__file__).parent / "data" / "slab_with_wall.toml")  
 def _cases():
     """[40, 4] poses and [40] expected truth: 16 standing, 12 too high, 12 inside the wall."""
     rng = np.random.default_rng(3)
-    stand = np.column_stack([rng.uniform(1.0, 3.0, 16), rng.uniform(1.0, 5.0, 16),
-                             np.where(np.arange(16) % 2 == 0, 1.0, NOMINAL_ROOT_HEIGHT),
-                             rng.uniform(-math.pi, math.pi, 16)])
-    high = np.column_stack([rng.uniform(1.0, 3.0, 12), rng.uniform(1.0, 5.0, 12), np.full(12, 2.0),
-                            rng.uniform(-math.pi, math.pi, 12)])
-    wall = np.column_stack([rng.uniform(4.4, 4.6, 12), rng.uniform(1.5, 4.5, 12), np.full(12, 1.0),
-                            rng.uniform(-math.pi, math.pi, 12)])
+    stand = np.column_stack(
+        [
+            rng.uniform(1.0, 3.0, 16),
+            rng.uniform(1.0, 5.0, 16),
+            np.where(np.arange(16) % 2 == 0, 1.0, NOMINAL_ROOT_HEIGHT),
+            rng.uniform(-math.pi, math.pi, 16),
+        ]
+    )
+    high = np.column_stack(
+        [
+            rng.uniform(1.0, 3.0, 12),
+            rng.uniform(1.0, 5.0, 12),
+            np.full(12, 2.0),
+            rng.uniform(-math.pi, math.pi, 12),
+        ]
+    )
+    wall = np.column_stack(
+        [
+            rng.uniform(4.4, 4.6, 12),
+            rng.uniform(1.5, 4.5, 12),
+            np.full(12, 1.0),
+            rng.uniform(-math.pi, math.pi, 12),
+        ]
+    )
     return np.concatenate([stand, high, wall]), np.repeat([True, False, False], [16, 12, 12])
 
 
@@ -66,20 +83,30 @@ def test_ground_truth_pool_matches_in_process(truth):
 
 
 def test_condition_on_obvious_cases_old_and_new_defaults():
-    old = ReachabilityConfig(trunk_radius=0.30, trunk_bottom=-0.63, trunk_top=0.60, leg_radius=0.25,
-                             leg_bottom=-1.06, leg_top=-0.54)
+    old = ReachabilityConfig(
+        trunk_radius=0.30,
+        trunk_bottom=-0.63,
+        trunk_top=0.60,
+        leg_radius=0.25,
+        leg_bottom=-1.06,
+        leg_top=-0.54,
+    )
     for config in (old, ReachabilityConfig()):
         predicted = rc.condition(TERRAIN, POSES, config)
         np.testing.assert_array_equal(predicted, EXPECTED)
         # The search's NumPy form agrees with the jitted condition, on these poses and on
         # the thresholds that flip them (the high roots become valid with a low enough leg_bottom).
-        samples = rc.raster_samples(TERRAIN, POSES, config.trunk_radius, config.leg_radius,
-                                    config.leg_lateral_offset)
-        np.testing.assert_array_equal(rc.thresholds(samples, config.trunk_bottom, config.leg_bottom, config.leg_top),
-                                      predicted)
+        samples = rc.raster_samples(
+            TERRAIN, POSES, config.trunk_radius, config.leg_radius, config.leg_lateral_offset
+        )
+        np.testing.assert_array_equal(
+            rc.thresholds(samples, config.trunk_bottom, config.leg_bottom, config.leg_top), predicted
+        )
         low = dataclasses.replace(config, leg_bottom=-2.1)
-        np.testing.assert_array_equal(rc.thresholds(samples, low.trunk_bottom, low.leg_bottom, low.leg_top),
-                                      rc.condition(TERRAIN, POSES, low))
+        np.testing.assert_array_equal(
+            rc.thresholds(samples, low.trunk_bottom, low.leg_bottom, low.leg_top),
+            rc.condition(TERRAIN, POSES, low),
+        )
         assert rc.condition(TERRAIN, POSES, low)[16:28].all()
 
 
@@ -106,8 +133,13 @@ def test_flat_ground_constraint():
 
 
 def test_tiny_grid_search_separates_the_cases(truth):
-    grid = {"trunk_radius": (0.30,), "leg_radius": (0.05, 0.25), "trunk_bottom": (-0.5, -0.63),
-            "leg_bottom": (-1.175, -2.1), "leg_top": (-0.525,)}
+    grid = {
+        "trunk_radius": (0.30,),
+        "leg_radius": (0.05, 0.25),
+        "trunk_bottom": (-0.5, -0.63),
+        "leg_bottom": (-1.175, -2.1),
+        "leg_top": (-0.525,),
+    }
     fit = np.ones(len(POSES), dtype=bool)
     result = rc.grid_search(TERRAIN, POSES, truth, fit, ReachabilityConfig(), grid)
     assert result["met"] and result["candidates"] == 2 * 4
@@ -135,8 +167,14 @@ def test_sample_poses_seeded_and_in_range():
 def test_walking_truth_rejects_crouched_roots_the_static_truth_accepts():
     """Talos stands crouched 0.6 m above the ground, but the generator does not walk that low."""
     rng = np.random.default_rng(5)
-    crouched = np.column_stack([rng.uniform(1.0, 3.0, 3), rng.uniform(1.5, 4.5, 3), np.full(3, 0.6),
-                                rng.uniform(-math.pi, math.pi, 3)])
+    crouched = np.column_stack(
+        [
+            rng.uniform(1.0, 3.0, 3),
+            rng.uniform(1.5, 4.5, 3),
+            np.full(3, 0.6),
+            rng.uniform(-math.pi, math.pi, 3),
+        ]
+    )
     poses = np.concatenate([POSES[:3], crouched])
     static = rc.ground_truth(TERRAIN, poses, workers=1)
     walking = rc.ground_truth(TERRAIN, poses, workers=1, truth="walking")
@@ -153,8 +191,14 @@ def test_hands_term_catches_grippers_beside_the_wall():
     cannot stand there. The hands term rejects them; its NumPy form in the search agrees
     with the jitted condition, and a search over the hands grid turns the term on."""
     rng = np.random.default_rng(4)
-    side = np.column_stack([np.full(6, 4.3 - 0.35), rng.uniform(2.0, 4.0, 6), np.full(6, 1.0),
-                            rng.choice([-math.pi / 2, math.pi / 2], 6)])
+    side = np.column_stack(
+        [
+            np.full(6, 4.3 - 0.35),
+            rng.uniform(2.0, 4.0, 6),
+            np.full(6, 1.0),
+            rng.choice([-math.pi / 2, math.pi / 2], 6),
+        ]
+    )
     poses = np.concatenate([POSES[:16], side])
     truth = rc.ground_truth(TERRAIN, poses, workers=1)
     assert truth[:16].all() and not truth[16:].any()
@@ -163,13 +207,30 @@ def test_hands_term_catches_grippers_beside_the_wall():
     hands = dataclasses.replace(base, hand_radius=0.13)
     predicted = rc.condition(TERRAIN, poses, hands)
     np.testing.assert_array_equal(predicted, truth)
-    samples = rc.raster_samples(TERRAIN, poses, base.trunk_radius, base.leg_radius, base.leg_lateral_offset,
-                                hand_radius=0.13)
-    np.testing.assert_array_equal(rc.thresholds(samples, base.trunk_bottom, base.leg_bottom, base.leg_top,
-                                                hand_bottom=hands.hand_bottom), predicted)
-    grid = {"trunk_radius": (0.30,), "leg_radius": (0.05,), "trunk_bottom": (base.trunk_bottom,),
-            "leg_bottom": (base.leg_bottom,), "leg_top": (base.leg_top,)}
-    terms = {"trunk_radius": (0.30,), "leg_radius": (0.05,), "leg_forward": (0.0,), "foothold": (None,),
-             "foothold_spread": (0.02,), "hand": (None, 0.13), "hand_bottom": (-0.40,)}
+    samples = rc.raster_samples(
+        TERRAIN, poses, base.trunk_radius, base.leg_radius, base.leg_lateral_offset, hand_radius=0.13
+    )
+    np.testing.assert_array_equal(
+        rc.thresholds(
+            samples, base.trunk_bottom, base.leg_bottom, base.leg_top, hand_bottom=hands.hand_bottom
+        ),
+        predicted,
+    )
+    grid = {
+        "trunk_radius": (0.30,),
+        "leg_radius": (0.05,),
+        "trunk_bottom": (base.trunk_bottom,),
+        "leg_bottom": (base.leg_bottom,),
+        "leg_top": (base.leg_top,),
+    }
+    terms = {
+        "trunk_radius": (0.30,),
+        "leg_radius": (0.05,),
+        "leg_forward": (0.0,),
+        "foothold": (None,),
+        "foothold_spread": (0.02,),
+        "hand": (None, 0.13),
+        "hand_bottom": (-0.40,),
+    }
     result = rc.grid_search(TERRAIN, poses, truth, np.ones(len(poses), dtype=bool), base, grid, terms)
     assert result["met"] and result["config"].hand_radius == 0.13 and result["config"].hand_bottom == -0.40

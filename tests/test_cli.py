@@ -7,19 +7,35 @@ import numpy as np
 import pytest
 
 from leas_jax.cli import main
-from leas_jax.training import preset, train
 
 ARENA = "terrains/training_arena.toml"
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["train", "--preset", "fast", "--out", "x"], "invalid choice: 'fast'"),
-    (["train", "--out", "x", "--timesteps", "-5"], "expected a positive integer"),
-    (["rollout", "--checkpoint", "nowhere", "--terrain", ARENA, "--start", "1,2", "--target", "3,4",
-      "--out", "g.npz"], "--start expects 3"),
-    (["rollout"], "the following arguments are required"),
-    (["bogus"], "invalid choice: 'bogus'"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["train", "--preset", "fast", "--out", "x"], "invalid choice: 'fast'"),
+        (["train", "--out", "x", "--timesteps", "-5"], "expected a positive integer"),
+        (
+            [
+                "rollout",
+                "--checkpoint",
+                "nowhere",
+                "--terrain",
+                ARENA,
+                "--start",
+                "1,2",
+                "--target",
+                "3,4",
+                "--out",
+                "g.npz",
+            ],
+            "--start expects 3",
+        ),
+        (["rollout"], "the following arguments are required"),
+        (["bogus"], "invalid choice: 'bogus'"),
+    ],
+)
 def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
     with pytest.raises(SystemExit) as exit_info:
         main(argv)
@@ -28,12 +44,29 @@ def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
     assert len(err.splitlines()) == 1 and fragment in err and "Traceback" not in err
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["rollout", "--checkpoint", "nowhere", "--terrain", ARENA, "--start", "1,2,0", "--target", "3,4",
-      "--out", "g.npz"], "no policy.pkl"),
-    (["train", "--out", "x", "--terrain", "missing.toml"], "--terrain: no such file"),
-    (["terrain", "show", "missing.toml", "--out", "m.png"], "missing.toml"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (
+            [
+                "rollout",
+                "--checkpoint",
+                "nowhere",
+                "--terrain",
+                ARENA,
+                "--start",
+                "1,2,0",
+                "--target",
+                "3,4",
+                "--out",
+                "g.npz",
+            ],
+            "no policy.pkl",
+        ),
+        (["train", "--out", "x", "--terrain", "missing.toml"], "--terrain: no such file"),
+        (["terrain", "show", "missing.toml", "--out", "m.png"], "missing.toml"),
+    ],
+)
 def test_bad_files_are_one_line_with_exit_code_2(capsys, tmp_path, monkeypatch, argv, fragment):
     monkeypatch.chdir(tmp_path)
     code = main(argv)
@@ -43,8 +76,21 @@ def test_bad_files_are_one_line_with_exit_code_2(capsys, tmp_path, monkeypatch, 
 
 def test_rollout_writes_guide_and_plot(run_dir, tmp_path, capsys):
     out = tmp_path / "guide.npz"
-    code = main(["rollout", "--checkpoint", str(run_dir), "--terrain", ARENA, "--start", "3.0,3.0,0.0",
-                 "--target", "6.0,3.0", "--out", str(out)])
+    code = main(
+        [
+            "rollout",
+            "--checkpoint",
+            str(run_dir),
+            "--terrain",
+            ARENA,
+            "--start",
+            "3.0,3.0,0.0",
+            "--target",
+            "6.0,3.0",
+            "--out",
+            str(out),
+        ]
+    )
     assert code == 0
     data = np.load(out)
     guide = data["guide"]
@@ -57,8 +103,21 @@ def test_rollout_writes_guide_and_plot(run_dir, tmp_path, capsys):
 
 
 def test_rollout_rejects_a_start_outside_the_terrain(run_dir, tmp_path, capsys):
-    code = main(["rollout", "--checkpoint", str(run_dir), "--terrain", ARENA, "--start", "30,3,0",
-                 "--target", "6,3", "--out", str(tmp_path / "g.npz")])
+    code = main(
+        [
+            "rollout",
+            "--checkpoint",
+            str(run_dir),
+            "--terrain",
+            ARENA,
+            "--start",
+            "30,3,0",
+            "--target",
+            "6,3",
+            "--out",
+            str(tmp_path / "g.npz"),
+        ]
+    )
     assert code == 2 and "outside the terrain bounds" in capsys.readouterr().err
 
 

@@ -54,16 +54,21 @@ def _one_error_line(err: str) -> str:
 
 
 def test_plan_missing_guide_file(tmp_path, capsys):
-    code, _, err = run_leas(["plan", "--guide", str(tmp_path / "nope.npz"), "--out", str(tmp_path / "p.npz")], capsys)
+    code, _, err = run_leas(
+        ["plan", "--guide", str(tmp_path / "nope.npz"), "--out", str(tmp_path / "p.npz")], capsys
+    )
     assert code == 2
     line = _one_error_line(err)
     assert "--guide" in line and "nope.npz" in line and "no such file" in line
 
 
-@pytest.mark.parametrize("contents, key", [
-    (dict(guide=_guide()), "timestep"),
-    (dict(timestep=0.1, terrain=TERRAIN), "guide"),
-])
+@pytest.mark.parametrize(
+    "contents, key",
+    [
+        (dict(guide=_guide()), "timestep"),
+        (dict(timestep=0.1, terrain=TERRAIN), "guide"),
+    ],
+)
 def test_plan_guide_missing_key(tmp_path, capsys, contents, key):
     path = tmp_path / "g.npz"
     np.savez(path, **contents)
@@ -73,14 +78,20 @@ def test_plan_guide_missing_key(tmp_path, capsys, contents, key):
     assert str(path) in line and f"missing key '{key}'" in line
 
 
-@pytest.mark.parametrize("contents, message", [
-    (dict(guide=np.zeros((5, 3)), timestep=0.1), "key 'guide' must be a [T, 4]"),
-    (dict(guide=np.full((5, 4), np.nan), timestep=0.1), "key 'guide' contains NaN"),
-    (dict(guide=_guide(), timestep=-0.1), "key 'timestep' must be a positive"),
-    (dict(guide=_guide(), timestep=0.1, terrain=TERRAIN, target=[1.0, 2.0, 3.0]), "key 'target' must be 2"),
-    (dict(guide=_guide(), timestep=0.1, terrain=np.zeros(3)), "key 'terrain' must be a text scalar"),
-    (dict(guide=_guide(), timestep=0.1), "--terrain: required"),
-])
+@pytest.mark.parametrize(
+    "contents, message",
+    [
+        (dict(guide=np.zeros((5, 3)), timestep=0.1), "key 'guide' must be a [T, 4]"),
+        (dict(guide=np.full((5, 4), np.nan), timestep=0.1), "key 'guide' contains NaN"),
+        (dict(guide=_guide(), timestep=-0.1), "key 'timestep' must be a positive"),
+        (
+            dict(guide=_guide(), timestep=0.1, terrain=TERRAIN, target=[1.0, 2.0, 3.0]),
+            "key 'target' must be 2",
+        ),
+        (dict(guide=_guide(), timestep=0.1, terrain=np.zeros(3)), "key 'terrain' must be a text scalar"),
+        (dict(guide=_guide(), timestep=0.1), "--terrain: required"),
+    ],
+)
 def test_plan_bad_guide_contents(tmp_path, capsys, contents, message):
     path = tmp_path / "g.npz"
     np.savez(path, **contents)
@@ -94,13 +105,16 @@ def test_plan_bad_terrain_file_and_out_dir(tmp_path, capsys):
     np.savez(guide, guide=_guide(), timestep=0.1)
     bad = tmp_path / "bad.toml"
     bad.write_text(TERRAIN.replace("resolution = 0.02", "resolution = -0.02"))
-    code, _, err = run_leas(["plan", "--guide", str(guide), "--terrain", str(bad), "--out", str(tmp_path / "p.npz")],
-                            capsys)
+    code, _, err = run_leas(
+        ["plan", "--guide", str(guide), "--terrain", str(bad), "--out", str(tmp_path / "p.npz")], capsys
+    )
     assert code == 2 and "resolution" in _one_error_line(err)
     good = tmp_path / "t.toml"
     good.write_text(TERRAIN)
-    code, _, err = run_leas(["plan", "--guide", str(guide), "--terrain", str(good),
-                             "--out", str(tmp_path / "missing" / "p.npz")], capsys)
+    code, _, err = run_leas(
+        ["plan", "--guide", str(guide), "--terrain", str(good), "--out", str(tmp_path / "missing" / "p.npz")],
+        capsys,
+    )
     assert code == 2 and "--out" in _one_error_line(err) and "does not exist" in err
 
 
@@ -126,8 +140,15 @@ def test_verify_and_show_file_errors(tmp_path, capsys):
     code, _, err = run_leas(["verify", str(text)], capsys)
     assert code == 2 and "not a readable .npz" in _one_error_line(err)
     partial = tmp_path / "partial.npz"
-    np.savez(partial, q=np.zeros((1, 39)), guide_index=np.zeros(1, int), last_valid_index=0, coverage=0.0,
-             terrain=TERRAIN, guide=_guide())
+    np.savez(
+        partial,
+        q=np.zeros((1, 39)),
+        guide_index=np.zeros(1, int),
+        last_valid_index=0,
+        coverage=0.0,
+        terrain=TERRAIN,
+        guide=_guide(),
+    )
     for argv in (["verify", str(partial)], ["show", str(partial), "--out", str(tmp_path / "v.html")]):
         code, _, err = run_leas(argv, capsys)
         assert code == 2 and "missing key 'feet'" in _one_error_line(err) and str(partial) in err
@@ -137,7 +158,13 @@ def test_verify_and_show_file_errors(tmp_path, capsys):
 
 def test_load_guide_file_returns_contents(tmp_path):
     path = tmp_path / "g.npz"
-    np.savez(path, guide=_guide(7).astype(np.float32), timestep=np.float64(0.05), terrain=TERRAIN, target=[2.0, 0.5])
+    np.savez(
+        path,
+        guide=_guide(7).astype(np.float32),
+        timestep=np.float64(0.05),
+        terrain=TERRAIN,
+        target=[2.0, 0.5],
+    )
     loaded = commands.load_guide_file(path)
     assert loaded.guide.shape == (7, 4) and loaded.guide.dtype == np.float64
     assert loaded.timestep == 0.05 and loaded.terrain_text == TERRAIN

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from leas_jax.contacts import ContactPlan, commands
+from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT as H
 from leas_jax.errors import LeasError
-from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT as H
 
 DT = 0.1  # s
 TERRAIN = """
@@ -53,7 +53,9 @@ def files(tmp_path_factory):
     folder = tmp_path_factory.mktemp("cli_plans")
     (folder / "flat.toml").write_text(TERRAIN)
     # 1.2 m at 0.18 m/s on ground; the second guide walks off the edge at x = 2.
-    np.savez(folder / "walk.npz", guide=_guide(-0.5, 0.7, 68), timestep=DT, terrain=TERRAIN, target=[0.7, 0.0])
+    np.savez(
+        folder / "walk.npz", guide=_guide(-0.5, 0.7, 68), timestep=DT, terrain=TERRAIN, target=[0.7, 0.0]
+    )
     np.savez(folder / "edge.npz", guide=_guide(0.5, 3.0, 140), timestep=DT)
     return folder
 
@@ -62,7 +64,9 @@ def test_plan_verify_show(files, capsys, tmp_path):
     plan_path = tmp_path / "walk.plan.npz"
     assert main(["plan", "--guide", str(files / "walk.npz"), "--out", str(plan_path)]) == 0
     out = capsys.readouterr().out
-    match = re.search(r"coverage 1\.000, last_valid_index 67/67, footsteps (\d+), postures (\d+), time [\d.]+ s", out)
+    match = re.search(
+        r"coverage 1\.000, last_valid_index 67/67, footsteps (\d+), postures (\d+), time [\d.]+ s", out
+    )
     assert match, out
     plan = ContactPlan.load(plan_path)
     assert plan.coverage == 1.0 and len(plan) == int(match.group(2)) and int(match.group(1)) >= 4
@@ -90,8 +94,20 @@ def test_plan_verify_show(files, capsys, tmp_path):
 
 def test_plan_several_guides_with_terrain_file_and_a_worker(files, capsys, tmp_path):
     out_dir = tmp_path / "plans"
-    code = main(["plan", "--guide", str(files / "walk.npz"), str(files / "edge.npz"),
-                 "--terrain", str(files / "flat.toml"), "--out", str(out_dir), "--workers", "1"])
+    code = main(
+        [
+            "plan",
+            "--guide",
+            str(files / "walk.npz"),
+            str(files / "edge.npz"),
+            "--terrain",
+            str(files / "flat.toml"),
+            "--out",
+            str(out_dir),
+            "--workers",
+            "1",
+        ]
+    )
     assert code == 0
     out = capsys.readouterr().out
     assert "2 guides in" in out and "with 1 workers" in out

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from leas_jax.contacts.collision import robot_collision, terrain_collision
-from leas_jax.contacts.model import FOOT_CLEARANCE, NOMINAL_ROOT_HEIGHT, load_talos, rotz
+from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
+from leas_jax.contacts.robot.model import FOOT_CLEARANCE, NOMINAL_ROOT_HEIGHT, load_talos, rotz
 from leas_jax.terrain import loads_terrain
 
 HEAD = 'name = "c"\nbounds = [[-2.0, -2.0], [2.0, 2.0]]\nvoid_height = -2.0\nresolution = 0.05\n'
@@ -69,4 +69,6 @@ def test_crossed_legs_collide(talos):
     legs[1, 1] = 0.5  # right hip roll inward: shins cross
     q = talos.configuration(root, rot, legs)
     hits = robot.self_contacts(*robot.placements_pinocchio(talos, q), first_only=False)
-    assert any(robot.names[a].startswith("leg_left") and robot.names[b].startswith("leg_right") for a, b in hits)
+    assert any(
+        robot.names[a].startswith("leg_left") and robot.names[b].startswith("leg_right") for a, b in hits
+    )

@@ -6,8 +6,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from leas_jax.contacts import database as D
-from leas_jax.contacts.model import load_talos
+from leas_jax.contacts.robot import database as D
+from leas_jax.contacts.robot.model import load_talos
 
 SMALL = D.DatabaseConfig(samples=300, seed=7)
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from leas_jax.contacts import equilibrium as E
-from leas_jax.contacts.model import quat_xyzw_from_matrix, rotz
+from leas_jax.contacts.robot import equilibrium as E
+from leas_jax.contacts.robot.model import quat_xyzw_from_matrix, rotz
 
 MASS = 90.27  # kg, Talos (computeTotalMass of the example-robot-data model)
 
@@ -29,8 +29,15 @@ STANCES = {
     # a foot on a 0.3 rad slope, the other turned
     "slope": np.array([_foot(0, 0.085, 0, _pitch(0.3)), _foot(0.2, -0.085, 0.1, rotz(0.4))]),
 }
-COMS = [[0.0, 0.0, 0.87], [0.1, 0.05, 0.9], [0.15, -0.05, 1.0], [0.3, 0.0, 0.9], [-0.1, 0.1, 1.0],
-        [0.12, 0.1, 0.85], [0.0, 0.2, 0.87]]
+COMS = [
+    [0.0, 0.0, 0.87],
+    [0.1, 0.05, 0.9],
+    [0.15, -0.05, 1.0],
+    [0.3, 0.0, 0.9],
+    [-0.1, 0.1, 1.0],
+    [0.12, 0.1, 0.85],
+    [0.0, 0.2, 0.87],
+]
 
 
 @pytest.fixture(scope="module")
@@ -87,7 +94,9 @@ def test_no_contact_is_not_balanced(hpp):
 
 
 def test_missing_library_message(monkeypatch):
-    monkeypatch.setattr(E.sysconfig, "get_paths", lambda: {"purelib": "/nonexistent", "platlib": "/nonexistent"})
+    monkeypatch.setattr(
+        E.sysconfig, "get_paths", lambda: {"purelib": "/nonexistent", "platlib": "/nonexistent"}
+    )
     monkeypatch.setattr(E.site, "getsitepackages", lambda: [])
     monkeypatch.setattr(E.site, "getusersitepackages", lambda: "/nonexistent-user")
     with pytest.raises(ImportError, match="libhpp-centroidal-dynamics.so"):

@@ -1,5 +1,6 @@
 """Contact generator: coverage on feasible guides, failure before obstacles, plan format."""
 
+import dataclasses
 import time
 from pathlib import Path
 
@@ -7,9 +8,9 @@ import numpy as np
 import pytest
 
 from leas_jax.contacts import ContactPlan, GeneratorConfig, plan_contacts, verify
-from leas_jax.contacts.generator import ContactGenerator
-from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT as H
 from leas_jax.contacts.plan import PLAN_KEYS
+from leas_jax.contacts.planner.generator import ContactGenerator
+from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT as H
 from leas_jax.errors import UsageError
 from leas_jax.terrain import loads_terrain
 
@@ -118,8 +119,12 @@ def test_wall_stops_before_it():
 
 def test_narrow_bridge_crossed_on_its_centre_line():
     """A 0.30 m bridge (the narrowest of the issue's 0.30-0.45 m): two soles side by side just fit."""
-    bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
-                           + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    bridge = loads_terrain(
+        HEAD
+        + box([0.5, 0, -0.1], [3, 4, 0.2])
+        + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+        + box([5.5, 0, -0.1], [3, 4, 0.2])
+    )
     plan = plan_contacts(bridge, straight(0.0, 5.0), DT)
     assert plan.coverage == 1.0
     feet = plan.feet[:, :, :2][np.isfinite(plan.feet[:, :, 0])]
@@ -133,8 +138,12 @@ def test_bridge_crossed_by_a_guide_off_its_centre_line():
     the step targets move into the foot's lane of the beam, so both soles stay centred and
     the root's balancing shift absorbs the offset. At nominal places, the left sole took the
     centre line and the right one found no room beside it: the plan stopped at the bridge."""
-    bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
-                           + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    bridge = loads_terrain(
+        HEAD
+        + box([0.5, 0, -0.1], [3, 4, 0.2])
+        + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+        + box([5.5, 0, -0.1], [3, 4, 0.2])
+    )
     guide = straight(0.0, 5.0)
     guide[:, 1] = -0.04
     plan = plan_contacts(bridge, guide, DT)
@@ -146,20 +155,29 @@ def test_bridge_crossed_by_a_guide_off_its_centre_line():
     assert without_lanes.coverage < 1.0 and x_at(without_lanes, without_lanes.last_valid_index) < 2.2
 
 
-@pytest.mark.parametrize("sides, lane", [
-    ("void", True),  # the bridge: void on both sides
-    ("level", False),  # a narrow box of flat ground between two others
-    ("tread", False),  # a stair tread walked along: one side higher, one lower
-])
+@pytest.mark.parametrize(
+    "sides, lane",
+    [
+        ("void", True),  # the bridge: void on both sides
+        ("level", False),  # a narrow box of flat ground between two others
+        ("tread", False),  # a stair tread walked along: one side higher, one lower
+    ],
+)
 def test_beam_lanes_only_where_the_beam_drops_on_both_sides(sides, lane):
     side_tops = {"void": None, "level": (0.0, 0.0), "tread": (0.15, -0.15)}[sides]
-    text = (HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
-            + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    text = (
+        HEAD
+        + box([0.5, 0, -0.1], [3, 4, 0.2])
+        + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+        + box([5.5, 0, -0.1], [3, 4, 0.2])
+    )
     if side_tops is not None:
         for y, top in zip((1.075, -1.075), side_tops):
             text += box([3.0, y, (top - 1.0) / 2], [2.0, 1.85, top + 1.0])
     generator = ContactGenerator(loads_terrain(text))
-    target = np.array([3.0, 0.045, 0.0])  # the left sole's nominal place under a root 4 cm right of the centre line
+    target = np.array(
+        [3.0, 0.045, 0.0]
+    )  # the left sole's nominal place under a root 4 cm right of the centre line
     moved = generator._beam_lane(0, target, 0.0)
     expected = [3.0, 0.13 / 2 + 0.01 / 2, 0.0] if lane else target  # half a sole and half the feet gap
     np.testing.assert_allclose(moved, expected, atol=1e-9)
@@ -219,6 +237,7 @@ def test_single_support_with_a_shorter_root_shift_passes_a_pillar():
 def test_turning_too_fast_stops():
     """1.5 rad/s while walking: 0.75 rad per planning pose (stride 5), more than two
     steps can follow (hip yaw 0.35 rad inward); pi/9 rad/s (paper's omega_max) passes."""
+
     def turning(rate, count=100):
         yaw = rate * DT * np.arange(count)
         x = np.cumsum(0.1 * DT * np.cos(yaw))
@@ -255,7 +274,7 @@ def test_bad_inputs():
 
 def test_config_is_frozen_and_used():
     config = GeneratorConfig(stride=10)
-    with pytest.raises(Exception):
+    with pytest.raises(dataclasses.FrozenInstanceError):
         config.stride = 3
     generator = ContactGenerator(FLAT, config)
     plan = generator.plan(straight(0.0, 1.0), DT)
@@ -291,7 +310,9 @@ def test_the_foot_that_can_lead_steps_first_beside_a_void():
     plan = plan_contacts(bridge, data["guide"], float(data["timestep"]))
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    any_step = plan_contacts(bridge, data["guide"], float(data["timestep"]), GeneratorConfig(min_step_gain=None))
+    any_step = plan_contacts(
+        bridge, data["guide"], float(data["timestep"]), GeneratorConfig(min_step_gain=None)
+    )
     assert any_step.last_valid_index == 230 and data["guide"][230, 0] < 4.0
 
 
@@ -301,8 +322,12 @@ def test_soles_turn_to_a_narrow_bridge_axis():
     beam's axis fit; with the turning disabled this plan stops on the bridge. (At 0.2 rad
     staggered soles at the guide's yaw cross too, once a sole may rest across the
     platform's and the bridge's coplanar tops.)"""
-    bridge = loads_terrain(HEAD + box([0.5, 0, -0.1], [3, 4, 0.2]) + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
-                           + box([5.5, 0, -0.1], [3, 4, 0.2]))
+    bridge = loads_terrain(
+        HEAD
+        + box([0.5, 0, -0.1], [3, 4, 0.2])
+        + box([3.0, 0, -0.1], [2.0, 0.30, 0.2])
+        + box([5.5, 0, -0.1], [3, 4, 0.2])
+    )
     guide = straight(0.0, 5.0)
     guide[:, 3] = 0.3
     plan = plan_contacts(bridge, guide, DT)
@@ -310,7 +335,9 @@ def test_soles_turn_to_a_narrow_bridge_axis():
     assert verify(plan).ok
     feet = plan.feet[np.isfinite(plan.feet[:, :, 0])]
     on_bridge = feet[(feet[:, 0] > 2.1) & (feet[:, 0] < 3.9)]
-    yaws = np.arctan2(2 * (on_bridge[:, 6] * on_bridge[:, 5]), 1 - 2 * on_bridge[:, 5] ** 2)  # quaternion xyzw
+    yaws = np.arctan2(
+        2 * (on_bridge[:, 6] * on_bridge[:, 5]), 1 - 2 * on_bridge[:, 5] ** 2
+    )  # quaternion xyzw
     assert len(on_bridge) >= 4 and np.abs(yaws).max() < 1e-6
     stiff = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0))
     assert stiff.coverage < 1.0
@@ -330,7 +357,7 @@ def test_start_on_rubble_tries_other_soles():
     """A training-arena start on rubble tiles (the pose of a shipped-policy-like rollout):
     the best candidate of each foot gives a stance that fails its checks; a pair of
     lower-ranked candidates stands, and the one-posture plan passes `verify`."""
-    from leas_jax.contacts.generator import LEFT, RIGHT
+    from leas_jax.contacts.planner.generator import LEFT, RIGHT
     from leas_jax.terrain import load_terrain
 
     arena = load_terrain(Path(__file__).parents[1] / "terrains" / "training_arena.toml")
@@ -357,5 +384,7 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
     plan = plan_contacts(circuit, data["guide"], float(data["timestep"]))
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    held_under = plan_contacts(circuit, data["guide"], float(data["timestep"]), GeneratorConfig(swing_clearance=0.0))
+    held_under = plan_contacts(
+        circuit, data["guide"], float(data["timestep"]), GeneratorConfig(swing_clearance=0.0)
+    )
     assert held_under.last_valid_index == 160

@@ -4,8 +4,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from leas_jax.contacts.ik import leg_fk, leg_ik, leg_ik_single, within_limits
-from leas_jax.contacts.model import load_talos, quat_xyzw_from_matrix, rotz
+from leas_jax.contacts.robot.ik import leg_fk, leg_ik, leg_ik_single, within_limits
+from leas_jax.contacts.robot.model import load_talos, rotz
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from leas_jax.contacts import model as M
+from leas_jax.contacts.robot import model as M
 
 
 @pytest.fixture(scope="module")

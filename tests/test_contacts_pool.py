@@ -18,8 +18,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from leas_jax.contacts.pool import (PathResult, ValidationPool, ValidationPoolError, path_seed,
-                                    register_backend, validate_paths)
+from leas_jax.contacts.validation.pool import (
+    PathResult,
+    ValidationPool,
+    ValidationPoolError,
+    path_seed,
+    register_backend,
+    validate_paths,
+)
 from leas_jax.errors import UsageError
 from leas_jax.terrain import loads_terrain
 
@@ -91,8 +97,14 @@ def fake_plan(terrain, guide, timestep, config):
     # the last such pose. Depends only on the inputs.
     inside = (guide[:, 0] <= terrain.bounds[1, 0]) & (guide[:, 0] >= terrain.bounds[0, 0])
     last = int(np.nonzero(inside)[0][-1]) if inside.any() else -1
-    return FakePlan(coverage=float(inside.mean()), last_valid_index=last, noise=float(np.random.random()),
-                    pid=os.getpid(), calls=_CALLS, terrain_name=terrain.name)
+    return FakePlan(
+        coverage=float(inside.mean()),
+        last_valid_index=last,
+        noise=float(np.random.random()),
+        pid=os.getpid(),
+        calls=_CALLS,
+        terrain_name=terrain.name,
+    )
 
 
 def _guide(x0: float, length: int = 20, yaw: float = 0.0) -> np.ndarray:
@@ -111,8 +123,17 @@ def _batch() -> list[np.ndarray]:
 
 
 def _summary(results: list[PathResult]):
-    return [(r.index, r.coverage, r.last_valid_index, r.error, r.attempts,
-             None if r.plan is None else r.plan.noise) for r in results]
+    return [
+        (
+            r.index,
+            r.coverage,
+            r.last_valid_index,
+            r.error,
+            r.attempts,
+            None if r.plan is None else r.plan.noise,
+        )
+        for r in results
+    ]
 
 
 def test_same_results_for_0_1_2_workers():
@@ -235,10 +256,13 @@ def test_bad_inputs_raise_usage_errors():
     assert validate_paths(TERRAIN, [], 0.1, workers=2, plan_fn=fake_plan) == []
 
 
-@pytest.mark.parametrize("how, message", [
-    ("import", "died during start-up"),  # the child cannot even unpickle its target
-    ("terrain", "start-up failed: RuntimeError: crafted terrain failure"),  # PathRunner raised
-])
+@pytest.mark.parametrize(
+    "how, message",
+    [
+        ("import", "died during start-up"),  # the child cannot even unpickle its target
+        ("terrain", "start-up failed: RuntimeError: crafted terrain failure"),  # PathRunner raised
+    ],
+)
 def test_worker_startup_failure_fails_the_future_not_hangs(monkeypatch, how, message):
     monkeypatch.setenv("LEAS_TEST_BREAK_WORKER", how)  # read by this module in the workers
     pool = ValidationPool(TERRAIN, workers=1, plan_fn=fake_plan)
@@ -259,7 +283,7 @@ class _RecordingBackend:
     created: list = []
 
     def __init__(self, address, spec, workers, options):
-        from leas_jax.contacts.pool import PathRunner
+        from leas_jax.contacts.validation.pool import PathRunner
 
         self.runner = PathRunner(spec)
         _RecordingBackend.created.append((address, workers, options["max_attempts"]))

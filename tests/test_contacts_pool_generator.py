@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from leas_jax.contacts import ContactPlan, PathResult, ValidationPool, plan_contacts, validate_paths, verify
-from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT as H
+from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT as H
 from leas_jax.terrain import loads_terrain
 
 DT = 0.1  # s, paper Table I
@@ -82,7 +82,9 @@ def test_one_and_two_workers_give_the_same_plans(inline_results):
     _same_plans(two, inline_results)
     # Indices restart per batch; planning does not depend on them.
     assert [r.index for r in again] == [0, 1]
-    _same_plans([r for r in again], [PathResult(**{**vars(r), "index": i}) for i, r in enumerate(inline_results[3:])])
+    _same_plans(
+        [r for r in again], [PathResult(**{**vars(r), "index": i}) for i, r in enumerate(inline_results[3:])]
+    )
     assert verify(two[1].plan).ok  # a plan that came back through a pipe still verifies
 
 

@@ -16,13 +16,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from leas_jax.contacts import generator as generator_module
-from leas_jax.contacts import surfaces as surfaces_module
-from leas_jax.contacts.collision import robot_collision, terrain_collision
-from leas_jax.contacts.equilibrium import HppEquilibrium, flat_support_margin
-from leas_jax.contacts.generator import ContactGenerator, GeneratorConfig
-from leas_jax.contacts.model import load_talos
-from leas_jax.contacts.surfaces import SOLE_CORNERS, sole_rotation
+from leas_jax.contacts.planner import generator as generator_module
+from leas_jax.contacts.planner import surfaces as surfaces_module
+from leas_jax.contacts.planner.generator import ContactGenerator, GeneratorConfig
+from leas_jax.contacts.planner.surfaces import SOLE_CORNERS, sole_rotation
+from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
+from leas_jax.contacts.robot.equilibrium import HppEquilibrium, flat_support_margin
+from leas_jax.contacts.robot.model import load_talos
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -43,14 +43,22 @@ def terrain_contacts_reference(robot, rot, pos, terrain, first_only=True, aabb=N
     if len(terrain.aabb) == 0:
         return []
     aabb = robot.world_aabb(rot, pos) if aabb is None else aabb
-    overlap = np.all((aabb[:, None, 0] <= terrain.aabb[None, :, 1]) &
-                     (aabb[:, None, 1] >= terrain.aabb[None, :, 0]), axis=2)
+    overlap = np.all(
+        (aabb[:, None, 0] <= terrain.aabb[None, :, 1]) & (aabb[:, None, 1] >= terrain.aabb[None, :, 0]),
+        axis=2,
+    )
     hits = []
     request, result = coal.CollisionRequest(), coal.CollisionResult()
     for g, b in zip(*np.nonzero(overlap)):
         result.clear()
-        if coal.collide(robot.geometries[g], coal.Transform3s(rot[g], pos[g]), terrain.shapes[b],
-                        terrain.transforms[b], request, result):
+        if coal.collide(
+            robot.geometries[g],
+            coal.Transform3s(rot[g], pos[g]),
+            terrain.shapes[b],
+            terrain.transforms[b],
+            request,
+            result,
+        ):
             hits.append((int(g), int(b)))
             if first_only:
                 break
@@ -69,8 +77,14 @@ def self_contacts_reference(robot, rot, pos, first_only=True, aabb=None):
     request, result = coal.CollisionRequest(), coal.CollisionResult()
     for ga, gb in robot.self_pairs[overlap].tolist():
         result.clear()
-        if coal.collide(robot.geometries[ga], coal.Transform3s(rot[ga], pos[ga]),
-                        robot.geometries[gb], coal.Transform3s(rot[gb], pos[gb]), request, result):
+        if coal.collide(
+            robot.geometries[ga],
+            coal.Transform3s(rot[ga], pos[ga]),
+            robot.geometries[gb],
+            coal.Transform3s(rot[gb], pos[gb]),
+            request,
+            result,
+        ):
             hits.append((int(ga), int(gb)))
             if first_only:
                 break
@@ -126,7 +140,9 @@ def test_terrain_and_self_contacts_match(arena, talos):
     for rot, pos in random_placements(talos, robot, terrain, rng, 150):
         fast = robot.terrain_contacts(rot, pos, objects, first_only=False)
         assert fast == terrain_contacts_reference(robot, rot, pos, objects, first_only=False)
-        assert robot.terrain_contacts(rot, pos, objects) == terrain_contacts_reference(robot, rot, pos, objects)
+        assert robot.terrain_contacts(rot, pos, objects) == terrain_contacts_reference(
+            robot, rot, pos, objects
+        )
         terrain_hits += bool(fast)
         fast = robot.self_contacts(rot, pos, first_only=False)
         assert fast == self_contacts_reference(robot, rot, pos, first_only=False)
@@ -142,7 +158,9 @@ def test_flat_outside_support_fails_the_lp(talos):
     rejected = 0
     for _ in range(200):
         feet = rng.integers(1, 3)
-        pos = np.concatenate([rng.uniform(-0.2, 0.2, (feet, 2)), np.full((feet, 1), rng.uniform(-1, 1))], axis=1)
+        pos = np.concatenate(
+            [rng.uniform(-0.2, 0.2, (feet, 2)), np.full((feet, 1), rng.uniform(-1, 1))], axis=1
+        )
         rot = sole_rotation(np.tile([0.0, 0.0, 1.0], (feet, 1)), rng.uniform(-np.pi, np.pi, feet))
         points = np.concatenate([p + SOLE_CORNERS @ r.T for p, r in zip(pos, rot)])
         normals = np.repeat(rot[:, :, 2], 4, axis=0)
@@ -164,12 +182,22 @@ def reference_generator(terrain, monkeypatch):
     monkeypatch.setattr(generator_module, "_OUTSIDE_MARGIN", np.inf)
     generator = ContactGenerator(terrain, GeneratorConfig())
     robot = generator.robot
-    monkeypatch.setattr(robot, "terrain_contacts",
-                        lambda rot, pos, objects, first_only=True, aabb=None:
-                        terrain_contacts_reference(robot, rot, pos, objects, first_only, aabb), raising=False)
-    monkeypatch.setattr(robot, "self_contacts",
-                        lambda rot, pos, first_only=True, aabb=None:
-                        self_contacts_reference(robot, rot, pos, first_only, aabb), raising=False)
+    monkeypatch.setattr(
+        robot,
+        "terrain_contacts",
+        lambda rot, pos, objects, first_only=True, aabb=None: terrain_contacts_reference(
+            robot, rot, pos, objects, first_only, aabb
+        ),
+        raising=False,
+    )
+    monkeypatch.setattr(
+        robot,
+        "self_contacts",
+        lambda rot, pos, first_only=True, aabb=None: self_contacts_reference(
+            robot, rot, pos, first_only, aabb
+        ),
+        raising=False,
+    )
     return generator
 
 
@@ -190,8 +218,11 @@ def test_plans_match_the_slow_versions(arena, monkeypatch):
     assert sum(len(p) for p in plans) > 20  # the guides exercise the generator
 
 
-@pytest.mark.skipif(not REFERENCE.is_file(), reason="no saved reference plans (benchmarks/contact_planner_speed.py "
-                                                    "--save-reference .cache/contact_parity/arena_reference.npz)")
+@pytest.mark.skipif(
+    not REFERENCE.is_file(),
+    reason="no saved reference plans (benchmarks/contact_planner_speed.py "
+    "--save-reference .cache/contact_parity/arena_reference.npz)",
+)
 def test_plans_match_saved_reference():
     from leas_jax.terrain import load_terrain
 
@@ -204,7 +235,7 @@ def test_plans_match_saved_reference():
 
 def test_near_disk_and_column_match_near_column():
     """`near_disk` + `near_column_z` (one disk for several faces) = `near_column` = brute force."""
-    from leas_jax.contacts.database import leg_database
+    from leas_jax.contacts.robot.database import leg_database
 
     rng = np.random.default_rng(4)
     for side in (0, 1):
@@ -214,8 +245,9 @@ def test_near_disk_and_column_match_near_column():
             point = rng.uniform(lo - 0.05, hi + 0.05)
             radius, half = rng.uniform(0.02, 0.2), rng.uniform(0.02, 0.15)
             dx, dy = db.positions[:, 0] - point[0], db.positions[:, 1] - point[1]
-            brute = np.flatnonzero((dx * dx + dy * dy <= radius * radius) &
-                                   (np.abs(db.positions[:, 2] - point[2]) <= half))
+            brute = np.flatnonzero(
+                (dx * dx + dy * dy <= radius * radius) & (np.abs(db.positions[:, 2] - point[2]) <= half)
+            )
             column = db.near_column(point, radius, half)
             assert np.array_equal(column, brute)
             assert np.array_equal(db.near_column_z(db.near_disk(point, radius), point[2], half), brute)
@@ -244,7 +276,7 @@ def legs_joint_frames_reference(hip_offset, thigh, shin, q):
 
 
 def test_legs_joint_frames_match(talos):
-    from leas_jax.contacts.collision import _legs_joint_frames
+    from leas_jax.contacts.robot.collision import _legs_joint_frames
 
     hip = np.array([leg.hip_offset for leg in talos.legs])
     thigh = np.array([leg.thigh for leg in talos.legs])
@@ -252,4 +284,6 @@ def test_legs_joint_frames_match(talos):
     rng = np.random.default_rng(5)
     for _ in range(500):
         q = rng.uniform(-2.5, 2.5, (2, 6))
-        assert np.array_equal(_legs_joint_frames(hip, thigh, shin, q), legs_joint_frames_reference(hip, thigh, shin, q))
+        assert np.array_equal(
+            _legs_joint_frames(hip, thigh, shin, q), legs_joint_frames_reference(hip, thigh, shin, q)
+        )

@@ -2,12 +2,12 @@
 
 import numpy as np
 
-from leas_jax.contacts.generator import _rotz
-from leas_jax.contacts.surfaces import find_support, sole_inside_union, surface_arrays
+from leas_jax.contacts.planner.generator import _rotz
+from leas_jax.contacts.planner.surfaces import find_support, sole_inside_union, surface_arrays
 from leas_jax.terrain import loads_terrain
 
 HEAD = 'name = "s"\nbounds = [[-2.0, -2.0], [4.0, 2.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
-TOL = 0.005  # m, DESIGN §6 check 1
+TOL = 0.005  # m, docs/design.md §6 check 1
 
 
 def box(center, size):
@@ -16,9 +16,14 @@ def box(center, size):
 
 # Tops at z = 0: A x in [-1, 0] and B x in [0, 1] meet at x = 0; C x in [1.03, 2] is 3 cm
 # beyond B (a gap); D x in [-1, 1], y in [1.2, 1.8] touches nothing; E, 0.1 m higher, touches B.
-TERRAIN = loads_terrain(HEAD + box([-0.5, 0, -0.1], [1, 1, 0.2]) + box([0.5, 0, -0.1], [1, 1, 0.2])
-                        + box([1.515, 0, -0.1], [0.97, 1, 0.2]) + box([0, 1.5, -0.1], [2, 0.6, 0.2])
-                        + box([0.5, -0.75, -0.05], [1, 0.5, 0.3]))
+TERRAIN = loads_terrain(
+    HEAD
+    + box([-0.5, 0, -0.1], [1, 1, 0.2])
+    + box([0.5, 0, -0.1], [1, 1, 0.2])
+    + box([1.515, 0, -0.1], [0.97, 1, 0.2])
+    + box([0, 1.5, -0.1], [2, 0.6, 0.2])
+    + box([0.5, -0.75, -0.05], [1, 0.5, 0.3])
+)
 
 
 def test_groups_join_touching_faces_of_one_plane_only():

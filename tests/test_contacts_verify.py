@@ -4,12 +4,14 @@ import numpy as np
 import pytest
 
 from leas_jax.contacts import ContactPlan, plan_contacts, verify
-from leas_jax.contacts.model import NOMINAL_ROOT_HEIGHT as H
-from leas_jax.contacts.model import load_talos
+from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT as H
+from leas_jax.contacts.robot.model import load_talos
 from leas_jax.terrain import loads_terrain
 
-TEXT = ('name = "v"\nbounds = [[-1.0, -2.0], [4.0, 2.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
-        "[[box]]\ncenter = [1.5, 0.0, -0.1]\nsize = [5.0, 4.0, 0.2]\n")
+TEXT = (
+    'name = "v"\nbounds = [[-1.0, -2.0], [4.0, 2.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
+    "[[box]]\ncenter = [1.5, 0.0, -0.1]\nsize = [5.0, 4.0, 0.2]\n"
+)
 
 
 @pytest.fixture(scope="module")
@@ -25,8 +27,15 @@ def plan():
 
 
 def _with(plan, **changes):
-    fields = dict(q=plan.q, feet=plan.feet, guide_index=plan.guide_index, last_valid_index=plan.last_valid_index,
-                  coverage=plan.coverage, terrain=plan.terrain, guide=plan.guide)
+    fields = dict(
+        q=plan.q,
+        feet=plan.feet,
+        guide_index=plan.guide_index,
+        last_valid_index=plan.last_valid_index,
+        coverage=plan.coverage,
+        terrain=plan.terrain,
+        guide=plan.guide,
+    )
     fields.update(changes)
     return ContactPlan(**fields)
 
@@ -51,8 +60,11 @@ def test_untampered_plan_passes(plan):
 
 def test_moved_foot(plan):
     # A double-support posture whose left foot was already down in the one before.
-    k = next(k for k in range(len(plan) // 2, len(plan) - 1)
-             if np.all(np.isfinite(plan.feet[k])) and np.all(np.isfinite(plan.feet[k - 1, 0])))
+    k = next(
+        k
+        for k in range(len(plan) // 2, len(plan) - 1)
+        if np.all(np.isfinite(plan.feet[k])) and np.all(np.isfinite(plan.feet[k - 1, 0]))
+    )
     feet = plan.feet.copy()
     feet[k, 0, 0] += 0.03  # 3 cm forward in the file, q unchanged
     report = verify(_with(plan, feet=feet))
@@ -77,8 +89,11 @@ def test_com_outside_support(plan):
     stays between the feet, outside the right sole (the steps are still legal, check 5)."""
     feet = plan.feet.copy()
     # A posture that only moves the root: both neighbours have the same feet down.
-    k = next(k for k in range(len(plan) // 2, len(plan) - 1)
-             if np.all(np.isfinite(feet[k - 1:k + 2])) and np.array_equal(feet[k - 1], feet[k + 1]))
+    k = next(
+        k
+        for k in range(len(plan) // 2, len(plan) - 1)
+        if np.all(np.isfinite(feet[k - 1 : k + 2])) and np.array_equal(feet[k - 1], feet[k + 1])
+    )
     feet[k, 0] = np.nan
     report = verify(_with(plan, feet=feet))
     assert report.checks_failed() == {4}
@@ -104,7 +119,7 @@ def test_two_feet_moved_at_once(plan):
     for end in range(start + 1, len(plan)):
         if np.all(np.isfinite(feet[end])) and np.all(np.abs(feet[end, :, 0] - feet[start, :, 0]) > 1e-3):
             break
-    keep = np.r_[0:start + 1, end:len(plan)]
+    keep = np.r_[0 : start + 1, end : len(plan)]
     report = verify(_with(plan, q=plan.q[keep], feet=feet[keep], guide_index=plan.guide_index[keep]))
     assert report.checks_failed() == {5}
     messages = [m for p, c, m in report.failures if p == start + 1]

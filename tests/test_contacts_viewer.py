@@ -32,7 +32,6 @@ size = [1.0, 2.0, 0.2]
 """
 
 
-
 @pytest.fixture(scope="module")
 def plan() -> ContactPlan:
     """Seven postures of Talos at half-sitting: left step, right step, left step.
@@ -49,8 +48,12 @@ def plan() -> ContactPlan:
     frames = [model.getFrameId(name) for name in ("leg_left_sole_fix_joint", "leg_right_sole_fix_joint")]
     base = model.referenceConfigurations["half_sitting"].copy()
     pin.framesForwardKinematics(model, data, base)
-    soles = np.array([np.concatenate([data.oMf[f].translation, pin.Quaternion(data.oMf[f].rotation).coeffs()])
-                      for f in frames])
+    soles = np.array(
+        [
+            np.concatenate([data.oMf[f].translation, pin.Quaternion(data.oMf[f].rotation).coeffs()])
+            for f in frames
+        ]
+    )
     foot_x = [0.0, 0.0]
     qs, feet = [], []
     for air, lands in ((None, None), (0, None), (None, 0), (1, None), (None, 1), (0, None), (None, 0)):
@@ -65,8 +68,15 @@ def plan() -> ContactPlan:
         qs.append(q)
         feet.append(rows)
     guide = np.stack([np.linspace(0.0, 2.4, 25), np.zeros(25), np.full(25, 1.02), np.zeros(25)], axis=1)
-    return ContactPlan(q=np.array(qs), feet=np.array(feet), guide_index=np.arange(7) * 2, last_valid_index=12,
-                    coverage=0.5, terrain=TERRAIN, guide=guide)
+    return ContactPlan(
+        q=np.array(qs),
+        feet=np.array(feet),
+        guide_index=np.arange(7) * 2,
+        last_valid_index=12,
+        coverage=0.5,
+        terrain=TERRAIN,
+        guide=guide,
+    )
 
 
 def _decode(b64: str, dtype) -> np.ndarray:
@@ -140,8 +150,11 @@ def test_write_html_is_self_contained_with_consistent_data(plan, tmp_path):
     # The left ankle-roll mesh sits above the left sole (sole frame 0.107 m below
     # the ankle): its placement at posture 2 (plan index 4) is ~0.1 m above feet[4, 0].
     model, visual_model, *_ = viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)
-    drawn = [g for g, geom in enumerate(visual_model.geometryObjects)
-             if viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)[3][g] >= 0]
+    drawn = [
+        g
+        for g, geom in enumerate(visual_model.geometryObjects)
+        if viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)[3][g] >= 0
+    ]
     slot = drawn.index(visual_model.getGeometryId("leg_left_6_link_0"))
     ankle = matrices[2, slot, :, 3]
     assert np.linalg.norm(ankle[:2] - plan.feet[4, 0, :2]) < 0.05
@@ -196,7 +209,11 @@ def test_html_renderer_runs_under_node(plan, tmp_path):
     viewer.write_html(plan, path, max_postures=4)
     data, code = _page_parts(path.read_text())
     n_geoms = len(data["robot"]["geoms"])
-    script = (f"const PLAN_JSON = {json.dumps(json.dumps(data))};\n" + _HARNESS + code + r"""
+    script = (
+        f"const PLAN_JSON = {json.dumps(json.dumps(data))};\n"
+        + _HARNESS
+        + code
+        + r"""
 const first = drawsOf(0);
 const mark = calls.length;
 element("show-all").checked = true;
@@ -205,7 +222,8 @@ element("show-all").onchange();
 const all = drawsOf(mark);
 console.log(JSON.stringify({first, all, rendered: element("body").dataset.rendered,
                             label: element("posture-label").textContent, max: element("posture").max}));
-""")
+"""
+    )
     (tmp_path / "run.js").write_text(script)
     done = subprocess.run(["node", str(tmp_path / "run.js")], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
@@ -243,8 +261,15 @@ def test_footsteps_png_shows_feet_guide_and_failed_tail(plan, tmp_path):
 
 def test_empty_plan_still_renders(plan, tmp_path):
     # A generator that fails at the first pose returns no posture at all.
-    empty = ContactPlan(q=np.zeros((0, 39)), feet=np.zeros((0, 2, 7)), guide_index=np.zeros(0, int),
-                     last_valid_index=-1, coverage=0.0, terrain=TERRAIN, guide=plan.guide)
+    empty = ContactPlan(
+        q=np.zeros((0, 39)),
+        feet=np.zeros((0, 2, 7)),
+        guide_index=np.zeros(0, int),
+        last_valid_index=-1,
+        coverage=0.0,
+        terrain=TERRAIN,
+        guide=plan.guide,
+    )
     assert viewer.footprints(empty) == [] and viewer.count_footsteps(empty) == 0
     viewer.write_html(empty, tmp_path / "v.html")
     data, _ = _page_parts((tmp_path / "v.html").read_text())

@@ -8,8 +8,15 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from leas_jax.env import EnvConfig, FreshResetVmap, RewardWeights, LeasEnv, heightfield_from_raster, heightfield_from_terrain
-from leas_jax.env import reachability
+from leas_jax.env import (
+    EnvConfig,
+    FreshResetVmap,
+    LeasEnv,
+    RewardWeights,
+    heightfield_from_raster,
+    heightfield_from_terrain,
+    reachability,
+)
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import TRAINING_ENV
 
@@ -113,7 +120,9 @@ def test_clearance_term_is_off_by_default_and_costs_its_weight_near_the_edge():
         env = LeasEnv(heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0, config), config)
         return env.step(env.reset_to(pose, 0.0, target_dir=jnp.array([1.0, 0.0])), stand)
 
-    paper = first_step(TRAINING_ENV)  # the presets' condition (the default's lookahead legs would be over the void)
+    paper = first_step(
+        TRAINING_ENV
+    )  # the presets' condition (the default's lookahead legs would be over the void)
     assert float(paper.metrics["reward/clearance"]) == 0.0
     weighted = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=2.0), clearance_margin=0.10)
     near = first_step(weighted)

@@ -2,13 +2,11 @@
 
 import math
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from leas_jax.env import EnvConfig, heightfield_from_raster
-from leas_jax.env import heightmap, kinematics, reachability, reward
+from leas_jax.env import EnvConfig, heightfield_from_raster, heightmap, kinematics, reachability, reward
 from leas_jax.env.field import disk_filter, sample_bilinear, sample_nearest
 
 RES = 0.02
@@ -30,6 +28,7 @@ def cell(x):
 
 # -- kinematics -------------------------------------------------------------
 
+
 def test_integrate_one_step_by_hand():
     pos, vel, yaw = jnp.array([0.0, 0.0, 1.0]), jnp.array([0.1, 0.0, 0.0]), jnp.array(0.0)
     accel, omega = kinematics.scale_action(jnp.array([1.0, 0.0, 0.0, 0.5]), yaw, CFG)
@@ -42,8 +41,9 @@ def test_integrate_one_step_by_hand():
 
 def test_velocity_norm_is_clipped_at_v_max():
     vel = jnp.array([0.3, 0.0, 0.0])
-    _, new_vel, _ = kinematics.integrate(jnp.zeros(3), vel, jnp.array(0.0), jnp.array([0.1, 0.1, 0.0]),
-                                         jnp.array(0.0), CFG)
+    _, new_vel, _ = kinematics.integrate(
+        jnp.zeros(3), vel, jnp.array(0.0), jnp.array([0.1, 0.1, 0.0]), jnp.array(0.0), CFG
+    )
     # 0.3 + 0.01 along x, 0.01 along y -> norm > 0.3, rescaled to exactly 0.3
     assert float(jnp.linalg.norm(new_vel)) == pytest.approx(0.30, abs=1e-6)
     assert float(new_vel[1] / new_vel[0]) == pytest.approx(0.01 / 0.31, rel=1e-5)
@@ -58,11 +58,14 @@ def test_actions_accelerate_in_the_root_frame_and_are_clipped():
 
 def test_vertical_acceleration_has_its_own_bound():
     import dataclasses
+
     config = dataclasses.replace(CFG, vertical_a_max=3.0)
     accel, _ = kinematics.scale_action(jnp.array([1.0, -0.5, -0.5, 0.0]), jnp.array(0.0), config)
     # x, y keep a_max = 0.1 m/s^2 per action unit; z: 3.0 m/s^2 per unit (HPP's verticalAccelerationBound)
     np.testing.assert_allclose(accel, [0.1, -0.05, -1.5], atol=1e-6)
-    _, new_vel, _ = kinematics.integrate(jnp.zeros(3), jnp.zeros(3), jnp.array(0.0), accel, jnp.array(0.0), config)
+    _, new_vel, _ = kinematics.integrate(
+        jnp.zeros(3), jnp.zeros(3), jnp.array(0.0), accel, jnp.array(0.0), config
+    )
     np.testing.assert_allclose(new_vel, [0.01, -0.005, -0.15], atol=1e-6)
 
 
@@ -71,6 +74,7 @@ def test_yaw_wraps_to_minus_pi_pi():
 
 
 # -- heightfield sampling ----------------------------------------------------
+
 
 def test_bilinear_is_exact_on_a_plane_and_void_outside():
     n = 101
@@ -102,6 +106,7 @@ def test_disk_filter_matches_brute_force():
 
 # -- heightmap ---------------------------------------------------------------
 
+
 def test_heightmap_grid_matches_the_paper():
     offsets = heightmap.grid_offsets()
     assert offsets.shape == (77, 2)
@@ -114,8 +119,8 @@ def test_heightmap_grid_matches_the_paper():
 
 def test_heightmap_flat_step_and_clipping():
     heights = flat()
-    heights[cell(5.3):, :] = 0.3  # a 0.3 m step starting at x = 5.3
-    heights[:, cell(6.0):] = 2.0  # a tall wall from y = 6.0 (clipped at -0.2)
+    heights[cell(5.3) :, :] = 0.3  # a 0.3 m step starting at x = 5.3
+    heights[:, cell(6.0) :] = 2.0  # a tall wall from y = 6.0 (clipped at -0.2)
     field = field_of(heights)
     hmap = np.asarray(heightmap.sample(field, jnp.array([5.0, 5.0, 1.0, 0.0]))).reshape(11, 7)
     # rows: x = 0.72 ... 0.08 ahead (rows 0..8), then -0.2, -0.4; points with x >= 5.3 see 0.3 - 1.0
@@ -134,6 +139,7 @@ def test_heightmap_flat_step_and_clipping():
 
 # -- reachability ------------------------------------------------------------
 
+
 def pose(x, y, z, yaw=0.0):
     return jnp.array([x, y, z, yaw])
 
@@ -142,25 +148,28 @@ def pose(x, y, z, yaw=0.0):
 def scene():
     """10 x 10 m: ground at 0; a 2 x 2 m hole; a 1.5 m wall; a 0.30 m bridge over void."""
     heights = flat()
-    heights[cell(6.0):cell(8.0), cell(1.0):cell(3.0)] = -2.0  # hole x 6-8, y 1-3
-    heights[cell(1.0):cell(1.2), cell(5.0):cell(9.0)] = 1.5  # wall x 1.0-1.2, y 5-9
-    heights[cell(5.0):cell(9.0), cell(5.0):cell(9.5)] = -2.0  # void x 5-9, y 5-9.5 ...
-    heights[cell(5.0):cell(9.0), cell(6.85):cell(7.15) + 1] = 0.0  # ... crossed by a bridge y 6.85-7.15
+    heights[cell(6.0) : cell(8.0), cell(1.0) : cell(3.0)] = -2.0  # hole x 6-8, y 1-3
+    heights[cell(1.0) : cell(1.2), cell(5.0) : cell(9.0)] = 1.5  # wall x 1.0-1.2, y 5-9
+    heights[cell(5.0) : cell(9.0), cell(5.0) : cell(9.5)] = -2.0  # void x 5-9, y 5-9.5 ...
+    heights[cell(5.0) : cell(9.0), cell(6.85) : cell(7.15) + 1] = 0.0  # ... crossed by a bridge y 6.85-7.15
     return field_of(heights)
 
 
-@pytest.mark.parametrize("case, p, expected", [
-    ("flat ground at 1.0 m", pose(3.0, 2.0, 1.0), True),
-    ("too high above the ground", pose(3.0, 2.0, 1.7), False),
-    ("too low: trunk in the ground", pose(3.0, 2.0, 0.5), False),
-    ("over the middle of a hole", pose(7.0, 2.0, 1.0), False),
-    ("sunk into the hole, 1 m above the void: the void is no floor", pose(7.0, 2.0, -1.0), False),
-    ("beyond the terrain border", pose(10.6, 5.0, 1.0), False),
-    ("beside a wall, 0.2 m away", pose(1.4, 7.0, 1.0), False),
-    ("0.5 m from the wall", pose(1.7, 7.0, 1.0), True),
-    ("on the bridge, facing along it", pose(7.0, 7.0, 1.0, 0.0), True),
-    ("beside the bridge over the void", pose(7.0, 7.6, 1.0, 0.0), False),
-])
+@pytest.mark.parametrize(
+    "case, p, expected",
+    [
+        ("flat ground at 1.0 m", pose(3.0, 2.0, 1.0), True),
+        ("too high above the ground", pose(3.0, 2.0, 1.7), False),
+        ("too low: trunk in the ground", pose(3.0, 2.0, 0.5), False),
+        ("over the middle of a hole", pose(7.0, 2.0, 1.0), False),
+        ("sunk into the hole, 1 m above the void: the void is no floor", pose(7.0, 2.0, -1.0), False),
+        ("beyond the terrain border", pose(10.6, 5.0, 1.0), False),
+        ("beside a wall, 0.2 m away", pose(1.4, 7.0, 1.0), False),
+        ("0.5 m from the wall", pose(1.7, 7.0, 1.0), True),
+        ("on the bridge, facing along it", pose(7.0, 7.0, 1.0, 0.0), True),
+        ("beside the bridge over the void", pose(7.0, 7.6, 1.0, 0.0), False),
+    ],
+)
 def test_reachability_cases(scene, case, p, expected):
     assert bool(reachability.valid(scene, p)) is expected, case
 
@@ -187,7 +196,9 @@ def test_clearance_shortfall_counts_the_probes_that_fail(scene):
     assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.05, reach)) == 0.0
     # 0.2 m up, the legs (down to 1.175 m below the root) miss the ground; 0.2 m down, the
     # trunk (from 0.825 m below the root) enters it
-    assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.2, reach)) == pytest.approx(2.0 / 6.0)
+    assert float(reachability.clearance_shortfall(scene, pose(3.0, 2.0, 1.0), 0.2, reach)) == pytest.approx(
+        2.0 / 6.0
+    )
     assert float(reachability.clearance_shortfall(scene, pose(1.40, 7.0, 1.0), 0.05, reach)) >= 0.5
 
 
@@ -205,6 +216,7 @@ def test_nearest_sampling_of_rasters():
 
 
 # -- reward ------------------------------------------------------------------
+
 
 def test_reward_terms_by_hand():
     target = jnp.array([1.0, 0.0])

@@ -9,7 +9,6 @@ import pytest
 from leas_jax.cli import main
 from leas_jax.eval import metrics
 from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for
-from leas_jax.training import preset, train
 
 # 6 x 4 m floor, a wall across x = 3 from y = 0 to y = 2.6 (the RRT goes round it),
 # starts near (1, 1), target (5, 1).
@@ -37,9 +36,24 @@ def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
     terrain = tmp_path / "wall.toml"
     terrain.write_text(WALL_SCENARIO)
     out = tmp_path / "eval"
-    code = main(["evaluate", "--terrain", str(terrain), "--methods", "rblin,rbkino,rbkino_rrt,leas,leas_rrt",
-                 "--checkpoint", str(run_dir), "--n-starts", "2", "--workers", "0", "--no-progress",
-                 "--out", str(out)])
+    code = main(
+        [
+            "evaluate",
+            "--terrain",
+            str(terrain),
+            "--methods",
+            "rblin,rbkino,rbkino_rrt,leas,leas_rrt",
+            "--checkpoint",
+            str(run_dir),
+            "--n-starts",
+            "2",
+            "--workers",
+            "0",
+            "--no-progress",
+            "--out",
+            str(out),
+        ]
+    )
     assert code == 0
     report = json.loads((out / "results.json").read_text())
     scenario = report["scenarios"]["wall_scenario"]
@@ -52,7 +66,7 @@ def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
         if t["error"] is None:
             guide = guides[f"wall_scenario/{k}"]
             assert guide.shape == (t["guide_length"], 4)
-            # success needs the whole guide covered (DESIGN §8)
+            # success needs the whole guide covered (docs/design.md §8)
             assert not t["success"] or t["last_valid_index"] == len(guide) - 1
     # RBLin and RBKino drive straight into the wall: the plan cannot cover their guides.
     for t in trajectories:
@@ -66,8 +80,9 @@ def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
     rows = list(csv.DictReader((out / "table.csv").open()))
     assert {r["method"] for r in rows} == {"rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt"}
     summary = scenario["summary"]["rblin"]["all"]
-    assert summary["coverage"] == pytest.approx(100 * np.mean([t["coverage"] for t in trajectories
-                                                               if t["method"] == "rblin"]), abs=1e-4)
+    assert summary["coverage"] == pytest.approx(
+        100 * np.mean([t["coverage"] for t in trajectories if t["method"] == "rblin"]), abs=1e-4
+    )
     assert "wall_scenario" in (out / "table.md").read_text()
     assert (out / "wall_scenario.png").stat().st_size > 10_000
     assert "coverage" in capsys.readouterr().out
@@ -96,16 +111,24 @@ def test_ground_runs_table_ii_cells():
     assert PAPER_TABLE_II[((150.0, 210.0), 0.01)] == {"rblin": 22.3, "rbkino": 76.5, "leas": 98.4}
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["evaluate", "--scenario", "moon", "--out", "o"], "unknown scenario moon"),
-    (["evaluate", "--scenario", "ground", "--methods", "rblin,teleport", "--out", "o"], "unknown method(s) teleport"),
-    (["evaluate", "--scenario", "ground", "--out", "o"], "--checkpoint is required"),
-    (["evaluate", "--out", "o"], "one of --scenario or --terrain"),
-    (["evaluate", "--scenario", "ground", "--terrain", "x.toml", "--out", "o"], "not both"),
-    (["evaluate", "--terrain", "missing.toml", "--out", "o"], "--terrain: no such file"),
-    (["evaluate", "--terrain", "terrains/training_arena.toml", "--methods", "rblin", "--out", "o"],
-     "no [scenario] table"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["evaluate", "--scenario", "moon", "--out", "o"], "unknown scenario moon"),
+        (
+            ["evaluate", "--scenario", "ground", "--methods", "rblin,teleport", "--out", "o"],
+            "unknown method(s) teleport",
+        ),
+        (["evaluate", "--scenario", "ground", "--out", "o"], "--checkpoint is required"),
+        (["evaluate", "--out", "o"], "one of --scenario or --terrain"),
+        (["evaluate", "--scenario", "ground", "--terrain", "x.toml", "--out", "o"], "not both"),
+        (["evaluate", "--terrain", "missing.toml", "--out", "o"], "--terrain: no such file"),
+        (
+            ["evaluate", "--terrain", "terrains/training_arena.toml", "--methods", "rblin", "--out", "o"],
+            "no [scenario] table",
+        ),
+    ],
+)
 def test_usage_errors_are_one_line(capsys, tmp_path, monkeypatch, argv, fragment):
     from leas_jax.training.config import REPO_ROOT
 
@@ -115,11 +138,20 @@ def test_usage_errors_are_one_line(capsys, tmp_path, monkeypatch, argv, fragment
     assert code == 2 and len(err.splitlines()) == 1 and fragment in err, err
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["evaluate", "--scenario", "ground", "--n-starts", "0", "--out", "o"], "--n-starts expects an integer >= 1"),
-    (["evaluate", "--scenario", "ground", "--workers", "-1", "--out", "o"], "--workers expects an integer >= 0"),
-    (["evaluate", "--scenario", "ground"], "the following arguments are required: --out"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (
+            ["evaluate", "--scenario", "ground", "--n-starts", "0", "--out", "o"],
+            "--n-starts expects an integer >= 1",
+        ),
+        (
+            ["evaluate", "--scenario", "ground", "--workers", "-1", "--out", "o"],
+            "--workers expects an integer >= 0",
+        ),
+        (["evaluate", "--scenario", "ground"], "the following arguments are required: --out"),
+    ],
+)
 def test_argument_errors_exit_2(capsys, argv, fragment):
     with pytest.raises(SystemExit) as info:
         main(argv)
@@ -138,9 +170,17 @@ def test_rrt_searches_are_the_same_in_worker_processes():
 
     terrain, env = loads_terrain(WALL_SCENARIO), EnvConfig()
     field = heightfield_from_terrain(terrain, env)
-    starts = Starts(np.array([[1.0, 1.0, 1.0, 0.0], [1.1, 0.9, 1.0, 0.2]]), np.array([0.0, 0.05]), np.zeros(2))
-    args = (terrain, env, starts, np.array([5.0, 1.0]), BaselineConfig.from_env(env),
-            RRTConfig(seed=3, max_iterations=400))
+    starts = Starts(
+        np.array([[1.0, 1.0, 1.0, 0.0], [1.1, 0.9, 1.0, 0.2]]), np.array([0.0, 0.05]), np.zeros(2)
+    )
+    args = (
+        terrain,
+        env,
+        starts,
+        np.array([5.0, 1.0]),
+        BaselineConfig.from_env(env),
+        RRTConfig(seed=3, max_iterations=400),
+    )
     here = _rrt_plans(field, *args, workers=0, progress=False)
     spawned = _rrt_plans(field, *args, workers=2, progress=False)
     assert [p.success for p in here] == [p.success for p in spawned]

@@ -4,10 +4,8 @@ import os
 from pathlib import Path
 
 import nbformat
-import pytest
 from nbclient import NotebookClient
 
-from leas_jax.training import preset, train
 from leas_jax.training.config import REPO_ROOT
 
 NOTEBOOKS = REPO_ROOT / "notebooks"
@@ -33,7 +31,9 @@ def _execute(name: str, env: dict, cwd: Path):
     old = {k: os.environ.get(k) for k in env}
     os.environ.update(env)  # the kernel inherits the parameters from this process
     try:
-        NotebookClient(notebook, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(cwd)}}).execute()
+        NotebookClient(
+            notebook, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(cwd)}}
+        ).execute()
     finally:
         for k, v in old.items():
             if v is None:
@@ -44,28 +44,47 @@ def _execute(name: str, env: dict, cwd: Path):
 
 
 def _outputs(notebook) -> str:
-    return "".join(o.get("text", "") + str(o.get("data", {}).get("text/markdown", ""))
-                   for cell in notebook.cells if cell.cell_type == "code" for o in cell.outputs)
+    return "".join(
+        o.get("text", "") + str(o.get("data", {}).get("text/markdown", ""))
+        for cell in notebook.cells
+        if cell.cell_type == "code"
+        for o in cell.outputs
+    )
 
 
 def test_learning_progression_notebook_runs(run_dir, tmp_path):
-    notebook = _execute("learning_progression.ipynb",
-                        {"LEAS_NB_RUN": str(run_dir), "LEAS_NB_N": "2", "LEAS_NB_STEPS": "20",
-                         "LEAS_NB_CHECKPOINTS": "2"}, tmp_path)
+    notebook = _execute(
+        "learning_progression.ipynb",
+        {"LEAS_NB_RUN": str(run_dir), "LEAS_NB_N": "2", "LEAS_NB_STEPS": "20", "LEAS_NB_CHECKPOINTS": "2"},
+        tmp_path,
+    )
     text = _outputs(notebook)
     assert "checkpoints:" in text and "valid starts of 4" in text
-    assert any(o.get("output_type") == "display_data" and "image/png" in o.get("data", {})
-               for cell in notebook.cells if cell.cell_type == "code" for o in cell.outputs)
+    assert any(
+        o.get("output_type") == "display_data" and "image/png" in o.get("data", {})
+        for cell in notebook.cells
+        if cell.cell_type == "code"
+        for o in cell.outputs
+    )
 
 
 def test_scenarios_notebook_runs(run_dir, tmp_path):
     terrain = tmp_path / "flat.toml"
     terrain.write_text(FLAT_SCENARIO)
     out = tmp_path / "eval"
-    notebook = _execute("scenarios.ipynb",
-                        {"LEAS_NB_RUN": str(run_dir), "LEAS_NB_N": "1", "LEAS_NB_METHODS": "rblin,leas",
-                         "LEAS_NB_WORKERS": "0", "LEAS_NB_OUT": str(out), "LEAS_NB_TERRAIN": str(terrain),
-                         "LEAS_NB_HOLE_WIDTHS": "0.6"}, tmp_path)
+    notebook = _execute(
+        "scenarios.ipynb",
+        {
+            "LEAS_NB_RUN": str(run_dir),
+            "LEAS_NB_N": "1",
+            "LEAS_NB_METHODS": "rblin,leas",
+            "LEAS_NB_WORKERS": "0",
+            "LEAS_NB_OUT": str(out),
+            "LEAS_NB_TERRAIN": str(terrain),
+            "LEAS_NB_HOLE_WIDTHS": "0.6",
+        },
+        tmp_path,
+    )
     assert (out / "results.json").is_file() and (out / "flat_scenario.png").is_file()
     assert (out / "hole_sweep" / "hole_sweep.png").is_file()
     text = _outputs(notebook)

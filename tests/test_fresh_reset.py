@@ -24,12 +24,20 @@ B, STEPS = 64, 300
 
 def _reference_step(env, state, action):
     """The plain fresh reset: `random_root` of every env, selected where done ([B] batch)."""
+
     def one(s, a):
         root, reward_value, done, metrics, truncation = env.transition(s.pipeline_state, a)
         fresh = env.random_root(root.rng)
         root = jax.tree.map(lambda new, old: jnp.where(done > 0, new, old), fresh, root)
-        return s.replace(pipeline_state=root, obs=env.observe(root), reward=reward_value, done=done,
-                         metrics=metrics, info={**s.info, "truncation": truncation})
+        return s.replace(
+            pipeline_state=root,
+            obs=env.observe(root),
+            reward=reward_value,
+            done=done,
+            metrics=metrics,
+            info={**s.info, "truncation": truncation},
+        )
+
     return jax.vmap(one)(state, action)
 
 
@@ -54,7 +62,9 @@ def runs():
             def body(s, a):
                 n = step(s, a)
                 return n, (n.pipeline_state, n.done, n.obs)
+
             return jax.lax.scan(body, start, actions)[1]
+
         return start, scan(wrapped.step), scan(lambda s, a: _reference_step(env, s, a))
 
     start, new, ref = run(field, jax.random.PRNGKey(7))
@@ -91,8 +101,11 @@ def test_each_capacity_draws_exactly_the_finished_envs(runs, count):
     got = jax.jit(lambda root, done: fresh_roots(env, root, done))(start, jnp.asarray(done))
     drawn = jax.jit(jax.vmap(env.random_root))(start.rng)
     for name in ("rng", "steps", "pos", "yaw", "vel", "target_dir"):
-        want = np.where(done.reshape((B,) + (1,) * (np.ndim(getattr(start, name)) - 1)),
-                        getattr(drawn, name), getattr(start, name))
+        want = np.where(
+            done.reshape((B,) + (1,) * (np.ndim(getattr(start, name)) - 1)),
+            getattr(drawn, name),
+            getattr(start, name),
+        )
         np.testing.assert_allclose(np.asarray(getattr(got, name)), want, atol=1e-6, err_msg=name)
 
 
@@ -113,8 +126,9 @@ def test_every_episode_starts_from_a_new_draw_of_its_key_chain(runs):
         np.testing.assert_allclose(np.asarray(expected.pos), starts[1:], atol=1e-5)
         np.testing.assert_allclose(np.asarray(expected.yaw), yaws[1:], atol=1e-6)
         assert len({tuple(k) for k in keys}) == len(keys), f"env {i} reuses a key"
-        assert len({(round(float(y), 6), *np.round(p, 6)) for p, y in zip(starts, yaws)}) == len(starts), \
+        assert len({(round(float(y), 6), *np.round(p, 6)) for p, y in zip(starts, yaws)}) == len(starts), (
             f"env {i} replays a start"
+        )
         episodes += len(ends)
     assert episodes > 5 * B
 
@@ -124,13 +138,20 @@ def test_start_distribution_matches_reset(runs):
     from scipy.stats import ks_2samp
 
     config, field, _, (roots, done, _), _ = runs
-    first = jax.device_get(jax.jit(jax.vmap(LeasEnv(field, config).reset))(
-        jax.random.split(jax.random.PRNGKey(11), 20_000)).pipeline_state)
+    first = jax.device_get(
+        jax.jit(jax.vmap(LeasEnv(field, config).reset))(
+            jax.random.split(jax.random.PRNGKey(11), 20_000)
+        ).pipeline_state
+    )
     later = done > 0
     assert later.sum() > 500
     speed = lambda vel: np.linalg.norm(vel[..., :2], axis=-1)  # noqa: E731
-    samples = {"x": (roots.pos[later][:, 0], first.pos[:, 0]), "y": (roots.pos[later][:, 1], first.pos[:, 1]),
-               "yaw": (roots.yaw[later], first.yaw), "speed": (speed(roots.vel[later]), speed(first.vel)),
-               "target": (np.arctan2(*roots.target_dir[later].T), np.arctan2(*first.target_dir.T))}
+    samples = {
+        "x": (roots.pos[later][:, 0], first.pos[:, 0]),
+        "y": (roots.pos[later][:, 1], first.pos[:, 1]),
+        "yaw": (roots.yaw[later], first.yaw),
+        "speed": (speed(roots.vel[later]), speed(first.vel)),
+        "target": (np.arctan2(*roots.target_dir[later].T), np.arctan2(*first.target_dir.T)),
+    }
     for name, (a, b) in samples.items():
         assert ks_2samp(a, b).pvalue > 1e-3, name

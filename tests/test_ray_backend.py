@@ -1,4 +1,4 @@
-"""The Ray backend of the validation pool (`leas_jax.contacts.ray_backend`).
+"""The Ray backend of the validation pool (`leas_jax.contacts.validation.ray_backend`).
 
 The slow tests start one local Ray instance with 2 CPUs (`address="local"`,
 `workers=2`) and need the `cluster` extra: `make test-cluster`. They reuse the
@@ -15,10 +15,10 @@ import time
 
 import numpy as np
 import pytest
-
-from leas_jax.contacts.pool import ValidationPool, ValidationPoolError, validate_paths
-from leas_jax.errors import UsageError
 from test_contacts_pool import EXIT, KILL_ONCE, SLEEP, TERRAIN, _batch, _guide, _summary, fake_plan
+
+from leas_jax.contacts.validation.pool import ValidationPool, ValidationPoolError, validate_paths
+from leas_jax.errors import UsageError
 
 
 def test_bad_addresses_give_clear_errors(monkeypatch):
@@ -26,15 +26,20 @@ def test_bad_addresses_give_clear_errors(monkeypatch):
         ValidationPool(TERRAIN, address="tcp://head:1", plan_fn=fake_plan)
     with monkeypatch.context() as patch:
         patch.setitem(sys.modules, "ray", None)  # as if Ray were not installed
-        with pytest.raises(ValidationPoolError, match=r"needs Ray, which is not installed: "
-                                                      r"pip install 'leas-jax\[cluster\]'"):
+        with pytest.raises(
+            ValidationPoolError,
+            match=r"needs Ray, which is not installed: "
+            r"pip install 'leas-jax\[cluster\]'",
+        ):
             ValidationPool(TERRAIN, address="ray://head:10001", plan_fn=fake_plan)
     pytest.importorskip("ray")
     import ray
 
     assert not ray.is_initialized()
-    for address, message in (("ray://head", "expected ray://HOST:PORT"),
-                             ("ray://127.0.0.1:1", "cannot reach the Ray client server at 127.0.0.1:1")):
+    for address, message in (
+        ("ray://head", "expected ray://HOST:PORT"),
+        ("ray://127.0.0.1:1", "cannot reach the Ray client server at 127.0.0.1:1"),
+    ):
         with pytest.raises(ValidationPoolError, match=message) as caught:
             ValidationPool(TERRAIN, address=address, plan_fn=fake_plan)
         assert isinstance(caught.value, UsageError)  # `leas` prints it on one line, exit code 2
@@ -94,10 +99,15 @@ def test_dead_actor_costs_a_retry_not_the_batch(local_ray):
     for i in (0, 3, 4):
         assert results[i].ok and results[i].attempts == 1 and results[i].coverage == 1.0
     # Killed on its first attempt only: planned by a fresh actor, same answer as in-process.
-    clean = validate_paths(TERRAIN, [_guide(0.1), _guide(0.2), _guide(0.3)], 0.1, workers=0, plan_fn=fake_plan)[2]
+    clean = validate_paths(
+        TERRAIN, [_guide(0.1), _guide(0.2), _guide(0.3)], 0.1, workers=0, plan_fn=fake_plan
+    )[2]
     assert results[2].ok and results[2].attempts == 2
-    assert (results[2].coverage, results[2].last_valid_index, results[2].plan.noise) == \
-        (clean.coverage, clean.last_valid_index, clean.plan.noise)
+    assert (results[2].coverage, results[2].last_valid_index, results[2].plan.noise) == (
+        clean.coverage,
+        clean.last_valid_index,
+        clean.plan.noise,
+    )
     # Killed on every attempt: retried once, then an error result for that path.
     dead = results[1]
     assert not dead.ok and dead.attempts == 2 and dead.plan is None and dead.last_valid_index == -1
@@ -108,16 +118,22 @@ def test_dead_actor_costs_a_retry_not_the_batch(local_ray):
 def test_timeout_kills_the_actor_and_reports_the_path(local_ray):
     with ValidationPool(TERRAIN, address="local", workers=1, plan_fn=fake_plan, task_timeout=2.0) as pool:
         results = pool.map([_guide(0.1, yaw=SLEEP), _guide(0.2)], 0.1, timeout=120)
-    assert results[0].error.startswith("TimeoutError: path 0 took longer than 2 s") and results[0].attempts == 1
+    assert (
+        results[0].error.startswith("TimeoutError: path 0 took longer than 2 s") and results[0].attempts == 1
+    )
     assert results[1].ok  # planned by the fresh actor
 
 
 @pytest.mark.slow
 def test_max_tasks_per_worker_recycles_actors(local_ray):
-    with ValidationPool(TERRAIN, address="local", workers=1, plan_fn=fake_plan, max_tasks_per_worker=2) as pool:
+    with ValidationPool(
+        TERRAIN, address="local", workers=1, plan_fn=fake_plan, max_tasks_per_worker=2
+    ) as pool:
         results = pool.map(_batch()[:5], 0.1, timeout=120)
     assert all(r.ok and r.attempts == 1 for r in results)
-    assert len({r.plan.pid for r in results}) == 3 and max(r.plan.calls for r in results) == 2  # 2 + 2 + 1 paths
+    assert (
+        len({r.plan.pid for r in results}) == 3 and max(r.plan.calls for r in results) == 2
+    )  # 2 + 2 + 1 paths
 
 
 @pytest.mark.slow
@@ -151,8 +167,16 @@ def test_real_generator_actor_killed_mid_batch(local_ray):
 def test_planner_training_on_ray(local_ray, tmp_path):
     from leas_jax.training import preset, train
 
-    config = preset("smoke", mode="planner", terrain="terrains/eval_ground.toml", num_timesteps=300, num_envs=4,
-                    num_minibatches=2, num_epochs=1, checkpoint_every_s=0.0)
+    config = preset(
+        "smoke",
+        mode="planner",
+        terrain="terrains/eval_ground.toml",
+        num_timesteps=300,
+        num_envs=4,
+        num_minibatches=2,
+        num_epochs=1,
+        checkpoint_every_s=0.0,
+    )
     records = []
     result = train(config, tmp_path / "run", progress=False, address="local", on_log=records.append)
     assert result.env_steps >= 300 and records
@@ -164,7 +188,7 @@ _CLIENT_DRIVER = """
 import json, sys
 sys.path.insert(0, {tests!r})
 from test_contacts_pool_generator import DT, GUIDES, TERRAIN
-from leas_jax.contacts.pool import validate_paths
+from leas_jax.contacts.validation.pool import validate_paths
 local = validate_paths(TERRAIN, GUIDES[:3], DT, workers=0)
 remote = validate_paths(TERRAIN, GUIDES[:3], DT, address={address!r})
 print(json.dumps([remote == local, all((a.plan.q == b.plan.q).all() for a, b in zip(remote, local)),
@@ -193,10 +217,24 @@ def test_ray_client_address():
     env = {**os.environ, "RAY_AUTH_MODE": "token"}
     temp_dir = tempfile.mkdtemp(prefix="leas-ray-")  # short: Ray's socket paths must fit in 107 bytes
     # Its own session: the head's daemons share its process group, killed as one at the end.
-    head = subprocess.Popen([ray_cli, "start", "--head", "--block", "--num-cpus=1", f"--port={ports[0]}",
-                             f"--ray-client-server-port={ports[1]}", "--include-dashboard=false",
-                             "--disable-usage-stats", f"--temp-dir={temp_dir}"],
-                            env=env, start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    head = subprocess.Popen(
+        [
+            ray_cli,
+            "start",
+            "--head",
+            "--block",
+            "--num-cpus=1",
+            f"--port={ports[0]}",
+            f"--ray-client-server-port={ports[1]}",
+            "--include-dashboard=false",
+            "--disable-usage-stats",
+            f"--temp-dir={temp_dir}",
+        ],
+        env=env,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline:
@@ -207,7 +245,9 @@ def test_ray_client_address():
                 assert head.poll() is None, "ray start --head exited"
                 time.sleep(0.5)
         driver = _CLIENT_DRIVER.format(tests=os.path.dirname(__file__), address=f"ray://127.0.0.1:{ports[1]}")
-        done = subprocess.run([sys.executable, "-c", driver], env=env, capture_output=True, text=True, timeout=300)
+        done = subprocess.run(
+            [sys.executable, "-c", driver], env=env, capture_output=True, text=True, timeout=300
+        )
         assert done.returncode == 0, done.stderr[-3000:]
         same, same_q, attempts = json.loads(done.stdout.strip().splitlines()[-1])
         assert same and same_q and attempts == [1, 1, 1]

@@ -19,8 +19,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from leas_jax.env import EnvConfig, ReachabilityConfig, heightfield_from_raster
-from leas_jax.env import reachability
+from leas_jax.env import EnvConfig, ReachabilityConfig, heightfield_from_raster, reachability
 from leas_jax.env.field import foothold_raster
 from leas_jax.training.config import REACHABILITY_TERMS_OFF
 
@@ -40,8 +39,9 @@ def cell(x):
 
 
 def field_of(heights, reach: ReachabilityConfig, require_spawn=False):
-    return heightfield_from_raster(heights, (0.0, 0.0), RES, VOID, EnvConfig(reachability=reach),
-                                   require_spawn=require_spawn)
+    return heightfield_from_raster(
+        heights, (0.0, 0.0), RES, VOID, EnvConfig(reachability=reach), require_spawn=require_spawn
+    )
 
 
 def pose(x, y, z=1.0, yaw=0.0):
@@ -56,7 +56,7 @@ def valid(field, p, reach):
 def hole_terrain():
     """Flat ground at 0 with the void for x >= 2.0 m (a cliff edge along y)."""
     heights = np.zeros((SIZE, SIZE), np.float32)
-    heights[cell(2.0):, :] = VOID
+    heights[cell(2.0) :, :] = VOID
     return heights
 
 
@@ -86,11 +86,21 @@ def test_defaults_turn_on_every_optional_term(ridged_terrain):
     plain = field_of(heights, PLAIN)
     assert plain.hand_max.shape == (1, 1)
     t = reachability.terms(plain, pose(1.0, 1.0), PLAIN)
-    assert all(bool(t[k]) for k in ("left_ahead_touch", "right_ahead_touch", "left_foothold", "right_foothold",
-                                    "left_hand_free", "right_hand_free"))
+    assert all(
+        bool(t[k])
+        for k in (
+            "left_ahead_touch",
+            "right_ahead_touch",
+            "left_foothold",
+            "right_foothold",
+            "left_hand_free",
+            "right_hand_free",
+        )
+    )
 
 
 # -- lookahead legs -----------------------------------------------------------
+
 
 def test_lookahead_rejects_a_root_facing_a_cliff(hole_terrain):
     plain = PLAIN
@@ -112,8 +122,9 @@ def test_lookahead_rejects_a_root_facing_a_cliff(hole_terrain):
 def test_lookahead_centres_turn_with_the_yaw():
     reach = plain_with(leg_forward=0.2)
     centres = reachability.all_leg_centers(pose(1.0, 1.0, yaw=math.pi / 2), reach)
-    np.testing.assert_allclose(centres, [[1.0 - 0.085, 1.0], [1.0 + 0.085, 1.0],
-                                         [1.0 - 0.085, 1.2], [1.0 + 0.085, 1.2]], atol=1e-6)
+    np.testing.assert_allclose(
+        centres, [[1.0 - 0.085, 1.0], [1.0 + 0.085, 1.0], [1.0 - 0.085, 1.2], [1.0 + 0.085, 1.2]], atol=1e-6
+    )
     assert reachability.all_leg_centers(pose(1.0, 1.0), PLAIN).shape == (2, 2)
 
 
@@ -122,16 +133,17 @@ def test_lookahead_legs_use_the_band():
     # the band [leg_bottom, leg_top] = [-1.175, -0.75]; a 0.20 m step down puts it 1.20 m
     # below, out of reach. The legs themselves stand on the upper ground (1.0 m below).
     heights = np.zeros((SIZE, SIZE), np.float32)
-    heights[cell(2.0):, :] = -0.10
+    heights[cell(2.0) :, :] = -0.10
     ahead = plain_with(leg_forward=0.15)
     assert valid(field_of(heights, ahead), pose(1.90, 2.0), ahead)
-    heights[cell(2.0):, :] = -0.20
+    heights[cell(2.0) :, :] = -0.20
     field = field_of(heights, ahead)
     assert not valid(field, pose(1.90, 2.0), ahead)
     assert valid(field, pose(1.90, 2.0), PLAIN)
 
 
 # -- foothold -----------------------------------------------------------------
+
 
 def test_foothold_raster_by_hand():
     heights = np.zeros((41, 41), np.float32)
@@ -214,14 +226,25 @@ center = [3.0, 2.0, -0.1]
 size = [2.0, 1.0, 0.2]
 """)
     poses = rc.sample_poses(terrain, 400, seed=3)
-    for reach in (plain_with(leg_forward=0.15),
-                  plain_with(foothold_radius=0.065, foothold_search=0.10, foothold_spread=0.02),
-                  plain_with(leg_forward=0.1, foothold_spread=0.01, trunk_radius=0.2)):
+    for reach in (
+        plain_with(leg_forward=0.15),
+        plain_with(foothold_radius=0.065, foothold_search=0.10, foothold_spread=0.02),
+        plain_with(leg_forward=0.1, foothold_spread=0.01, trunk_radius=0.2),
+    ):
         jitted = rc.condition(terrain, poses, reach)
         foothold = None if reach.foothold_spread is None else (reach.foothold_radius, reach.foothold_search)
-        samples = rc.raster_samples(terrain, poses, reach.trunk_radius, reach.leg_radius, reach.leg_lateral_offset,
-                                    reach.leg_forward, foothold)
-        numpy = rc.thresholds(samples, reach.trunk_bottom, reach.leg_bottom, reach.leg_top, reach.foothold_spread)
+        samples = rc.raster_samples(
+            terrain,
+            poses,
+            reach.trunk_radius,
+            reach.leg_radius,
+            reach.leg_lateral_offset,
+            reach.leg_forward,
+            foothold,
+        )
+        numpy = rc.thresholds(
+            samples, reach.trunk_bottom, reach.leg_bottom, reach.leg_top, reach.foothold_spread
+        )
         np.testing.assert_array_equal(numpy, jitted)
         # the term matters on these poses: it rejects some that the plain condition accepts
         assert np.sum(rc.condition(terrain, poses, PLAIN) & ~jitted) > 0
@@ -232,7 +255,7 @@ def test_default_spawn_points_are_valid_for_every_yaw():
     0.085 m) a leg disk fits inside it, so a root beside the trench is valid only for
     some yaws; no spawn point may be such a root."""
     heights = np.zeros((SIZE, SIZE), np.float32)
-    heights[cell(2.0):cell(2.2), :] = VOID
+    heights[cell(2.0) : cell(2.2), :] = VOID
     reach = ReachabilityConfig()
     field = field_of(heights, reach, require_spawn=True)
     spawn = np.asarray(field.spawn_xy)
@@ -248,7 +271,7 @@ def test_default_spawn_points_are_valid_for_every_yaw():
 def wall_terrain():
     """Flat ground at 0 with a wall 1.0 m tall for y >= 2.5 m (its face along x)."""
     heights = np.zeros((SIZE, SIZE), np.float32)
-    heights[:, cell(2.5):] = 1.0
+    heights[:, cell(2.5) :] = 1.0
     return heights
 
 

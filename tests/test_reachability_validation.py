@@ -16,7 +16,9 @@ import common  # noqa: E402
 import reachability_calibration as rc  # noqa: E402
 import reachability_validation as rv  # noqa: E402
 
-WALL = load_terrain(Path(__file__).parent / "data" / "slab_with_wall.toml")  # ground at 0, wall x 4.3-4.7, y 1-5
+WALL = load_terrain(
+    Path(__file__).parent / "data" / "slab_with_wall.toml"
+)  # ground at 0, wall x 4.3-4.7, y 1-5
 
 
 def test_wilson_interval_by_hand():
@@ -69,8 +71,20 @@ def test_validation_end_to_end_on_fresh_arena_poses(tmp_path, monkeypatch):
     monkeypatch.setattr(common, "RESULTS", tmp_path / "results")
     calibration = tmp_path / "calibration.json"
     calibration.write_text(json.dumps({"chosen_with_hands": {"trunk_radius": 0.3, "trunk_bottom": -0.6}}))
-    rv.main(["--poses", "40", "--seed", "3", "--truth", "static", "--workers", "1",
-             "--calibration-json", str(calibration)])
+    rv.main(
+        [
+            "--poses",
+            "40",
+            "--seed",
+            "3",
+            "--truth",
+            "static",
+            "--workers",
+            "1",
+            "--calibration-json",
+            str(calibration),
+        ]
+    )
     report = json.loads((tmp_path / "results" / "reachability_validation.json").read_text())
     static = report["truths"]["static"]
     assert report["poses"] == 40 and 0 < static["feasible"] < 40

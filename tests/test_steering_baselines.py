@@ -7,7 +7,7 @@ import pytest
 
 from leas_jax.env import EnvConfig, heightfield_from_terrain
 from leas_jax.steering.baselines import BaselineConfig, heading_from_velocity
-from leas_jax.steering.rbkino import min_time, rbkino, rbkino_planar, steer
+from leas_jax.steering.rbkino import min_time, rbkino, steer
 from leas_jax.steering.rblin import rblin, rblin_planar, rblin_through
 from leas_jax.terrain import loads_terrain
 
@@ -55,8 +55,9 @@ def test_rbkino_reaches_goal_at_rest_within_bounds_and_slowest_axis_time():
         assert np.abs(vel).max() <= 0.18 + 1e-9
         assert np.abs(np.diff(vel, axis=0) / np.diff(t)[:, None]).max() <= 0.1 + 1e-6
         # Positions integrate the velocities (trapezoid rule on a fine grid).
-        integral = p0 + np.concatenate([np.zeros((1, 2)), np.cumsum(0.5 * (vel[1:] + vel[:-1]) * np.diff(t)[:, None],
-                                                                   axis=0)])
+        integral = p0 + np.concatenate(
+            [np.zeros((1, 2)), np.cumsum(0.5 * (vel[1:] + vel[:-1]) * np.diff(t)[:, None], axis=0)]
+        )
         np.testing.assert_allclose(integral, pos, atol=2e-5)
 
 
@@ -112,12 +113,16 @@ def test_rblin_brakes_from_initial_speed_along_heading():
     # 0.07 m/s at 0.1 m/s^2 stops in 0.7 s = 7 steps, covering 0.07^2 / 0.2 = 0.0245 m along +x.
     np.testing.assert_allclose(planar[7, :2], [2.0245, 3.0], atol=1e-12)
     np.testing.assert_allclose(planar[1:8, 2], 0.0)
-    np.testing.assert_allclose(planar[8 + 99, 2], math.atan2(2.0, -0.0245), atol=1e-9)  # after 100 rotation steps
+    np.testing.assert_allclose(
+        planar[8 + 99, 2], math.atan2(2.0, -0.0245), atol=1e-9
+    )  # after 100 rotation steps
     assert len(rblin_planar([2.0, 3.0, 0.0], [2.0, 5.0], 0.07, CONFIG, brake=False)) == len(planar) - 7
 
 
 def test_rblin_through_waypoints_visits_each(field):
-    guide = rblin_through(field, [1.0, 1.0, 1.0, 0.0], [[3.0, 1.0], [3.0, 3.0]], 0.0, BaselineConfig(rotation_steps=10))
+    guide = rblin_through(
+        field, [1.0, 1.0, 1.0, 0.0], [[3.0, 1.0], [3.0, 3.0]], 0.0, BaselineConfig(rotation_steps=10)
+    )
     for point in ([3.0, 1.0], [3.0, 3.0]):
         assert np.hypot(*(guide[:, :2] - point).T).min() < 1e-9
     np.testing.assert_allclose(guide[-1, :2], [3.0, 3.0])

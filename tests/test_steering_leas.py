@@ -10,8 +10,10 @@ from leas_jax.steering.leas import rollout_batch, start_poses
 from leas_jax.terrain import loads_terrain
 
 # Flat ground over x in [0, 3], void beyond (a hole the root walks into).
-CLIFF_TEXT = ('name = "cliff"\nbounds = [[0.0, -1.0], [6.0, 1.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
-              '[[box]]\ncenter = [1.5, 0.0, -0.1]\nsize = [3.0, 2.0, 0.2]\n')
+CLIFF_TEXT = (
+    'name = "cliff"\nbounds = [[0.0, -1.0], [6.0, 1.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
+    "[[box]]\ncenter = [1.5, 0.0, -0.1]\nsize = [3.0, 2.0, 0.2]\n"
+)
 CLIFF = loads_terrain(CLIFF_TEXT)
 
 
@@ -45,13 +47,24 @@ def test_evaluation_lets_the_contact_generator_judge_leas_paths_by_default():
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.steering.rrt import RRTConfig
 
-    terrain = loads_terrain(CLIFF_TEXT + '[scenario]\ntarget = [5.5, 0.0]\nstart_region = [[0.9, -0.1], [1.1, 0.1]]\n'
-                   'start_yaw_deg = [-5.0, 5.0]\nstart_speed = [0.0, 0.0]\nn_starts = 2\nseed = 0\n')
+    terrain = loads_terrain(
+        CLIFF_TEXT + "[scenario]\ntarget = [5.5, 0.0]\nstart_region = [[0.9, -0.1], [1.1, 0.1]]\n"
+        "start_yaw_deg = [-5.0, 5.0]\nstart_speed = [0.0, 0.0]\nn_starts = 2\nseed = 0\n"
+    )
     policy = FullSpeedAhead()
     env = policy.config.env
     field = heightfield_from_terrain(terrain, env)
-    args = ("cliff", terrain, field, cells_for("cliff", terrain.scenario), ("leas",), policy, 2,
-            BaselineConfig.from_env(env), RRTConfig())
+    args = (
+        "cliff",
+        terrain,
+        field,
+        cells_for("cliff", terrain.scenario),
+        ("leas",),
+        policy,
+        2,
+        BaselineConfig.from_env(env),
+        RRTConfig(),
+    )
     rolled, _ = build_trajectories(*args, progress=False, env=env)
     stopped, _ = build_trajectories(*args, progress=False, env=env, leas_stop_at_invalid=True)
     assert all(t.guide[-1, 0] > 5.0 for t in rolled)  # over the void, to the target

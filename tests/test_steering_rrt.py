@@ -33,8 +33,14 @@ def test_rrt_goes_around_a_wall_with_every_pose_valid():
     start = np.array([1.0, 1.0, 1.0, 0.0])
     direct, ok = lift_checked(field, np.linspace([1.0, 1.0, 0.0], [5.0, 1.0, 0.0], 50), 1.0)
     assert not ok.all()  # the straight line is blocked
-    result = plan_rrt(field, start, [5.0, 1.0], 0.05, terrain.bounds,
-                      rrt=RRTConfig(seed=0, max_iterations=1500, max_seconds=60.0))
+    result = plan_rrt(
+        field,
+        start,
+        [5.0, 1.0],
+        0.05,
+        terrain.bounds,
+        rrt=RRTConfig(seed=0, max_iterations=1500, max_seconds=60.0),
+    )
     assert result.success, (result.iterations, result.tree_sizes)
     guide = result.guide
     np.testing.assert_allclose(guide[0, [0, 1, 3]], [1.0, 1.0, 0.0], atol=1e-6)
@@ -48,8 +54,14 @@ def test_rrt_goes_around_a_wall_with_every_pose_valid():
     # consecutive poses at most v_max * sqrt(2) * dt apart (per-axis bound)
     assert np.hypot(*np.diff(guide[:, :2], axis=0).T).max() <= 0.18 * np.sqrt(2) * 0.1 + 1e-9
     # seeded: the same seed gives the same path
-    again = plan_rrt(field, start, [5.0, 1.0], 0.05, terrain.bounds,
-                     rrt=RRTConfig(seed=0, max_iterations=1500, max_seconds=60.0))
+    again = plan_rrt(
+        field,
+        start,
+        [5.0, 1.0],
+        0.05,
+        terrain.bounds,
+        rrt=RRTConfig(seed=0, max_iterations=1500, max_seconds=60.0),
+    )
     np.testing.assert_array_equal(again.states, result.states)
 
 
@@ -100,8 +112,14 @@ def test_bridge_test_samples_land_on_the_beam():
 
 def test_rrt_crosses_a_narrow_beam_with_every_pose_valid():
     terrain, field = _terrain_and_field(BEAM)
-    result = plan_rrt(field, np.array([1.0, 0.8, 1.0, 0.0]), [5.0, 2.2], 0.05, terrain.bounds,
-                      rrt=RRTConfig(seed=0, max_iterations=3000, max_seconds=120.0))
+    result = plan_rrt(
+        field,
+        np.array([1.0, 0.8, 1.0, 0.0]),
+        [5.0, 2.2],
+        0.05,
+        terrain.bounds,
+        rrt=RRTConfig(seed=0, max_iterations=3000, max_seconds=120.0),
+    )
     assert result.success, (result.iterations, result.tree_sizes)
     assert valid_poses(field, result.guide).all()
     over_void = result.guide[(result.guide[:, 0] > 2.0) & (result.guide[:, 0] < 4.0)]

@@ -41,13 +41,16 @@ def test_generate_eval_dir(tmp_path):
         assert (tmp_path / f"{name}.toml").read_text() == text
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["generate", "--seed", "-1"], "--seed -1: must be >= 0"),
-    (["generate", "--eval-dir", "/nonexistent/dir"], "--eval-dir /nonexistent/dir: not a directory"),
-    (["generate", "--eval-dir", ".", "--out", "x.toml"], "either --out or --eval-dir"),
-    (["show", "terrains/eval_ground.toml", "--out", "x.jpg"], "must be a .png file"),
-    (["export", "terrains/eval_ground.toml", "--out", "x.ply"], "unknown format '.ply'"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["generate", "--seed", "-1"], "--seed -1: must be >= 0"),
+        (["generate", "--eval-dir", "/nonexistent/dir"], "--eval-dir /nonexistent/dir: not a directory"),
+        (["generate", "--eval-dir", ".", "--out", "x.toml"], "either --out or --eval-dir"),
+        (["show", "terrains/eval_ground.toml", "--out", "x.jpg"], "must be a .png file"),
+        (["export", "terrains/eval_ground.toml", "--out", "x.ply"], "unknown format '.ply'"),
+    ],
+)
 def test_bad_arguments_are_usage_errors(argv, message):
     with pytest.raises(UsageError) as info:
         run(*argv)

@@ -9,8 +9,13 @@ import numpy as np
 import pytest
 
 from leas_jax.terrain import load_terrain, loads_terrain
-from leas_jax.terrain.generate import (CELL_KINDS, arena_cells, generate_eval_terrains, generate_training_arena,
-                                       ground_pieces)
+from leas_jax.terrain.generate import (
+    CELL_KINDS,
+    arena_cells,
+    generate_eval_terrains,
+    generate_training_arena,
+    ground_pieces,
+)
 
 TERRAINS = Path(__file__).resolve().parents[1] / "terrains"
 EVAL_NAMES = ["eval_ground", "eval_hole", "eval_bridge", "eval_stairs", "eval_stairs_side", "eval_circuit"]
@@ -129,7 +134,9 @@ def test_arena_stairs_rises_and_treads():
 
 
 def test_arena_slopes_bridges_and_obstacles():
-    slope_angles = [abs(math.degrees(b.rpy[1])) for t in _cell_terrain("slope") for b in t.boxes if b.rpy[1] != 0]
+    slope_angles = [
+        abs(math.degrees(b.rpy[1])) for t in _cell_terrain("slope") for b in t.boxes if b.rpy[1] != 0
+    ]
     assert len(slope_angles) == 2 * CELL_KINDS["slope"]
     assert 4.0 <= min(slope_angles) and max(slope_angles) <= 15.0
     for terrain in _cell_terrain("bridge"):
@@ -178,7 +185,9 @@ def _connected_edges(terrain, cells=10, cell=2.0, inset=0.1, need=0.6):
                     border, along = cell * (j + 1), cell * i + s
                     near.append(np.stack([along, np.full_like(along, border - inset)], 1))
                     far.append(np.stack([along, np.full_like(along, border + inset)], 1))
-    flat = (np.abs(terrain.height_at(np.array(near))) < 0.01) & (np.abs(terrain.height_at(np.array(far))) < 0.01)
+    flat = (np.abs(terrain.height_at(np.array(near))) < 0.01) & (
+        np.abs(terrain.height_at(np.array(far))) < 0.01
+    )
     return {key: (_longest_run(row) - 1) * 0.02 >= need for key, row in zip(keys, flat)}
 
 

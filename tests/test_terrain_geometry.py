@@ -96,8 +96,11 @@ def test_pitched_box_height_formula():
     # x sin p + z cos p = 0.1, i.e. z = 0.1 / cos p - x tan p = 0.1 * sqrt(1.0625) - 0.25 x.
     # The face spans |x| <= 1.0 cos p = 0.970 m horizontally; test |x| <= 0.9.
     pitch = math.atan(0.25)
-    terrain = make_terrain([Box([0.0, 0.0, 0.0], [2.0, 1.0, 0.2], [0.0, pitch, 0.0])],
-                           bounds=((-0.9, -0.4), (0.9, 0.4)), resolution=0.05)
+    terrain = make_terrain(
+        [Box([0.0, 0.0, 0.0], [2.0, 1.0, 0.2], [0.0, pitch, 0.0])],
+        bounds=((-0.9, -0.4), (0.9, 0.4)),
+        resolution=0.05,
+    )
     x, _ = grid(terrain)
     expected = 0.1 * math.sqrt(1.0625) - 0.25 * x
     np.testing.assert_allclose(terrain.raster(), expected, atol=1e-6)
@@ -107,24 +110,28 @@ def test_pitched_box_height_formula():
 def test_rolled_box_stands_on_its_side():
     # Roll by 90 degrees: the box's y axis points up, so a 1 x 2 x 0.5 box stands 2 m tall
     # over x in [-0.5, 0.5], y in [-0.25, 0.25]: top at z = 1.
-    terrain = make_terrain([Box([0.0, 0.0, 0.0], [1.0, 2.0, 0.5], [math.pi / 2, 0.0, 0.0])],
-                           bounds=((-1.0, -1.0), (1.0, 1.0)))
-    np.testing.assert_allclose(terrain.height_at([[0.4, 0.2], [0.4, 0.3], [0.6, 0.0]]), [1.0, -2.0, -2.0],
-                               atol=1e-12)
+    terrain = make_terrain(
+        [Box([0.0, 0.0, 0.0], [1.0, 2.0, 0.5], [math.pi / 2, 0.0, 0.0])], bounds=((-1.0, -1.0), (1.0, 1.0))
+    )
+    np.testing.assert_allclose(
+        terrain.height_at([[0.4, 0.2], [0.4, 0.3], [0.6, 0.0]]), [1.0, -2.0, -2.0], atol=1e-12
+    )
 
 
 def test_yawed_box_footprint():
     # A 1 x 1 m square turned by 45 degrees covers |x| + |y| <= sqrt(2) / 2 = 0.7071.
-    terrain = make_terrain([Box([0.0, 0.0, 0.0], [1.0, 1.0, 0.4], [0.0, 0.0, math.pi / 4])],
-                           bounds=((-1.0, -1.0), (1.0, 1.0)))
+    terrain = make_terrain(
+        [Box([0.0, 0.0, 0.0], [1.0, 1.0, 0.4], [0.0, 0.0, math.pi / 4])], bounds=((-1.0, -1.0), (1.0, 1.0))
+    )
     heights = terrain.height_at([[0.65, 0.0], [0.75, 0.0], [0.35, 0.35], [0.36, 0.36], [0.0, -0.7]])
     np.testing.assert_allclose(heights, [0.2, -2.0, 0.2, -2.0, 0.2], atol=1e-12)
 
 
 def test_hole_between_boxes_is_void():
     # two slabs with top 0 over x in [0, 0.3] and [0.7, 1.0]: the hole x in (0.3, 0.7) is void
-    terrain = make_terrain([Box([0.15, 0.5, -0.1], [0.3, 1.0, 0.2]), Box([0.85, 0.5, -0.1], [0.3, 1.0, 0.2])],
-                           void_height=-3.5)
+    terrain = make_terrain(
+        [Box([0.15, 0.5, -0.1], [0.3, 1.0, 0.2]), Box([0.85, 0.5, -0.1], [0.3, 1.0, 0.2])], void_height=-3.5
+    )
     expected_row = np.array([0, 0, 0, 0, -3.5, -3.5, -3.5, 0, 0, 0, 0], dtype=np.float32)
     np.testing.assert_array_equal(terrain.raster(), np.tile(expected_row[:, None], (1, 11)))
 
@@ -146,8 +153,13 @@ def test_overlapping_boxes_take_the_highest_point():
 
 
 def test_height_at_agrees_with_raster_on_grid_points():
-    terrain = make_terrain([Box([0.5, 0.4, 0.0], [0.7, 0.5, 0.3], [0.1, -0.2, 0.7]),
-                            Box([0.3, 0.6, 0.1], [0.4, 0.4, 0.1], [0.0, 0.0, 0.3])], resolution=0.02)
+    terrain = make_terrain(
+        [
+            Box([0.5, 0.4, 0.0], [0.7, 0.5, 0.3], [0.1, -0.2, 0.7]),
+            Box([0.3, 0.6, 0.1], [0.4, 0.4, 0.1], [0.0, 0.0, 0.3]),
+        ],
+        resolution=0.02,
+    )
     x, y = grid(terrain)
     exact = terrain.height_at(np.stack([x, y], axis=-1))
     assert exact.shape == terrain.shape
@@ -159,9 +171,13 @@ def test_height_at_many_points_matches_brute_force():
     # height_at buckets points by tile; compare with every box tested on every point,
     # including points outside the bounds and on the tile grid
     rng = np.random.default_rng(1)
-    boxes = [Box(rng.uniform(0, 5, 3), rng.uniform(0.1, 1.5, 3), rng.uniform(-0.4, 0.4, 3)) for _ in range(40)]
+    boxes = [
+        Box(rng.uniform(0, 5, 3), rng.uniform(0.1, 1.5, 3), rng.uniform(-0.4, 0.4, 3)) for _ in range(40)
+    ]
     terrain = make_terrain(boxes, bounds=((0.0, 0.0), (5.0, 5.0)))
-    xy = np.concatenate([rng.uniform(-1.0, 6.0, size=(20000, 2)), np.mgrid[0:5.5:0.5, 0:5.5:0.5].reshape(2, -1).T])
+    xy = np.concatenate(
+        [rng.uniform(-1.0, 6.0, size=(20000, 2)), np.mgrid[0:5.5:0.5, 0:5.5:0.5].reshape(2, -1).T]
+    )
     top = np.max([box.column_top(xy[:, 0], xy[:, 1]) for box in boxes], axis=0)
     expected = np.where(np.isfinite(top), top, -2.0)
     assert np.mean(expected > -2.0) > 0.3
@@ -175,8 +191,9 @@ def test_height_at_many_points_matches_brute_force():
 
 def test_raster_of_a_large_box_is_chunked_and_correct():
     # 2001 x 2001 = 4 million points under one box: more than one chunk of 2^20 points
-    terrain = make_terrain([Box([20.0, 20.0, -0.5], [40.0, 40.0, 1.0])], bounds=((0.0, 0.0), (40.0, 40.0)),
-                           resolution=0.02)
+    terrain = make_terrain(
+        [Box([20.0, 20.0, -0.5], [40.0, 40.0, 1.0])], bounds=((0.0, 0.0), (40.0, 40.0)), resolution=0.02
+    )
     heights = terrain.raster()
     assert heights.shape == (2001, 2001)
     assert np.all(heights == 0.0)
@@ -205,14 +222,17 @@ def test_axis_aligned_box_has_its_top_face():
     np.testing.assert_allclose(signed_area_normal(surface.vertices), [0, 0, 0.24], atol=1e-12)
 
 
-@pytest.mark.parametrize("slope_deg, mu, kept", [
-    (20.0, 0.5, True),  # tan 20 deg = 0.364 <= 0.5
-    (26.0, 0.5, True),  # atan 0.5 = 26.57 deg
-    (27.0, 0.5, False),
-    (30.0, 0.5, False),  # tan 30 deg = 0.577 > 0.5
-    (30.0, 0.6, True),  # ... <= 0.6
-    (-20.0, 0.5, True),
-])
+@pytest.mark.parametrize(
+    "slope_deg, mu, kept",
+    [
+        (20.0, 0.5, True),  # tan 20 deg = 0.364 <= 0.5
+        (26.0, 0.5, True),  # atan 0.5 = 26.57 deg
+        (27.0, 0.5, False),
+        (30.0, 0.5, False),  # tan 30 deg = 0.577 > 0.5
+        (30.0, 0.6, True),  # ... <= 0.6
+        (-20.0, 0.5, True),
+    ],
+)
 def test_slope_inside_or_outside_the_friction_cone(slope_deg, mu, kept):
     pitch = math.radians(slope_deg)
     terrain = make_terrain([Box([0.5, 0.5, 0.0], [0.5, 0.5, 0.1], [0.0, pitch, 0.3])])
@@ -226,7 +246,9 @@ def test_slope_inside_or_outside_the_friction_cone(slope_deg, mu, kept):
         # counter-clockwise about the normal, area 0.5 x 0.5
         np.testing.assert_allclose(area, 0.25 * surface.normal, atol=1e-12)
         # the polygon lies in the plane of the face, at the top of the box
-        np.testing.assert_allclose((surface.vertices - terrain.boxes[0].center) @ surface.normal, 0.05, atol=1e-12)
+        np.testing.assert_allclose(
+            (surface.vertices - terrain.boxes[0].center) @ surface.normal, 0.05, atol=1e-12
+        )
 
 
 def test_side_face_of_a_rolled_box_is_a_support_surface():
@@ -288,11 +310,17 @@ def test_mesh_has_the_boxes():
     assert mesh.vertices.shape == (16, 3) and mesh.faces.shape == (24, 3)
     # disjoint boxes: volume 2 x 2 x 0.2 + 0.6 x 0.8 x 0.2 = 0.8 + 0.096
     assert mesh.volume == pytest.approx(0.896, abs=1e-9)
-    np.testing.assert_allclose(np.sort(mesh.vertices, axis=0)[-8:].max(axis=0),
-                               np.max([b.vertices().max(axis=0) for b in terrain.boxes], axis=0), atol=1e-12)
+    np.testing.assert_allclose(
+        np.sort(mesh.vertices, axis=0)[-8:].max(axis=0),
+        np.max([b.vertices().max(axis=0) for b in terrain.boxes], axis=0),
+        atol=1e-12,
+    )
     for index, box in enumerate(terrain.boxes):
-        np.testing.assert_allclose(np.sort(mesh.vertices[8 * index:8 * index + 8], axis=0),
-                                   np.sort(box.vertices(), axis=0), atol=1e-12)
+        np.testing.assert_allclose(
+            np.sort(mesh.vertices[8 * index : 8 * index + 8], axis=0),
+            np.sort(box.vertices(), axis=0),
+            atol=1e-12,
+        )
 
 
 @pytest.mark.parametrize("suffix", [".xml", ".glb", ".obj", ".stl"])

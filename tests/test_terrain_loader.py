@@ -1,4 +1,4 @@
-"""Terrain file loading and validation (DESIGN §4): every rejection names file, key and value."""
+"""Terrain file loading and validation (docs/design.md §4): every rejection names file, key and value."""
 
 import math
 
@@ -59,10 +59,10 @@ def test_base_loads_with_every_field():
 
 
 def test_optional_parts_may_be_left_out():
-    text = BASE.replace('rpy = [0.0, 0.0, 0.0]\n', "").replace("waypoints = [[2.0, 1.5]]\n", "")
+    text = BASE.replace("rpy = [0.0, 0.0, 0.0]\n", "").replace("waypoints = [[2.0, 1.5]]\n", "")
     terrain = loads_terrain(text, SOURCE)
     assert terrain.scenario.waypoints is None
-    no_scenario = loads_terrain(text[:text.index("[scenario]")], SOURCE)
+    no_scenario = loads_terrain(text[: text.index("[scenario]")], SOURCE)
     assert no_scenario.scenario is None
 
 
@@ -95,58 +95,116 @@ REJECTIONS = {
     "name not a string": ('name = "unit"', "name = 3", "name", "3"),
     "empty name": ('name = "unit"', 'name = ""', "name", '""'),
     "bounds a string": ("bounds = [[0.0, 0.0], [4.0, 3.0]]", 'bounds = "big"', "bounds", '"big"'),
-    "bounds wrong shape": ("bounds = [[0.0, 0.0], [4.0, 3.0]]", "bounds = [0.0, 0.0, 4.0, 3.0]", "bounds",
-                           "[0.0, 0.0, 4.0, 3.0]"),
+    "bounds wrong shape": (
+        "bounds = [[0.0, 0.0], [4.0, 3.0]]",
+        "bounds = [0.0, 0.0, 4.0, 3.0]",
+        "bounds",
+        "[0.0, 0.0, 4.0, 3.0]",
+    ),
     "void_height a string": ("void_height = -2.0", 'void_height = "low"', "void_height", '"low"'),
     "resolution a boolean": ("resolution = 0.05", "resolution = true", "resolution", "true"),
-    "center of two numbers": ("center = [1.0, 1.0, 0.05]", "center = [1.0, 1.0]", "box[1].center", "[1.0, 1.0]"),
-    "size with a string": ("size = [0.5, 0.5, 0.1]", 'size = [0.5, "a", 0.1]', "box[1].size", '[0.5, "a", 0.1]'),
+    "center of two numbers": (
+        "center = [1.0, 1.0, 0.05]",
+        "center = [1.0, 1.0]",
+        "box[1].center",
+        "[1.0, 1.0]",
+    ),
+    "size with a string": (
+        "size = [0.5, 0.5, 0.1]",
+        'size = [0.5, "a", 0.1]',
+        "box[1].size",
+        '[0.5, "a", 0.1]',
+    ),
     "rpy a number": ("rpy = [0.0, 0.0, 0.0]", "rpy = 0.0", "box[0].rpy", "0.0"),
     "n_starts a float": ("n_starts = 5", "n_starts = 5.0", "scenario.n_starts", "5.0"),
     "seed a string": ("seed = 0", 'seed = "0"', "scenario.seed", '"0"'),
-    "waypoints of three numbers": ("waypoints = [[2.0, 1.5]]", "waypoints = [[2.0, 1.5, 0.0]]",
-                                   "scenario.waypoints", "[[2.0, 1.5, 0.0]]"),
+    "waypoints of three numbers": (
+        "waypoints = [[2.0, 1.5]]",
+        "waypoints = [[2.0, 1.5, 0.0]]",
+        "scenario.waypoints",
+        "[[2.0, 1.5, 0.0]]",
+    ),
     # non-positive sizes or resolution
     "zero resolution": ("resolution = 0.05", "resolution = 0.0", "resolution", "0.0"),
     "negative resolution": ("resolution = 0.05", "resolution = -0.05", "resolution", "-0.05"),
     "zero size": ("size = [0.5, 0.5, 0.1]", "size = [0.5, 0.0, 0.1]", "box[1].size", "[0.5, 0.0, 0.1]"),
     "negative size": ("size = [4.0, 3.0, 0.2]", "size = [4.0, 3.0, -0.2]", "box[0].size", "[4.0, 3.0, -0.2]"),
     # bounds order
-    "xmin == xmax": ("bounds = [[0.0, 0.0], [4.0, 3.0]]", "bounds = [[4.0, 0.0], [4.0, 3.0]]", "bounds",
-                     "[[4.0, 0.0], [4.0, 3.0]]"),
-    "xmin > xmax": ("bounds = [[0.0, 0.0], [4.0, 3.0]]", "bounds = [[5.0, 0.0], [4.0, 3.0]]", "bounds",
-                    "[[5.0, 0.0], [4.0, 3.0]]"),
-    "ymin > ymax": ("bounds = [[0.0, 0.0], [4.0, 3.0]]", "bounds = [[0.0, 3.5], [4.0, 3.0]]", "bounds",
-                    "[[0.0, 3.5], [4.0, 3.0]]"),
+    "xmin == xmax": (
+        "bounds = [[0.0, 0.0], [4.0, 3.0]]",
+        "bounds = [[4.0, 0.0], [4.0, 3.0]]",
+        "bounds",
+        "[[4.0, 0.0], [4.0, 3.0]]",
+    ),
+    "xmin > xmax": (
+        "bounds = [[0.0, 0.0], [4.0, 3.0]]",
+        "bounds = [[5.0, 0.0], [4.0, 3.0]]",
+        "bounds",
+        "[[5.0, 0.0], [4.0, 3.0]]",
+    ),
+    "ymin > ymax": (
+        "bounds = [[0.0, 0.0], [4.0, 3.0]]",
+        "bounds = [[0.0, 3.5], [4.0, 3.0]]",
+        "bounds",
+        "[[0.0, 3.5], [4.0, 3.0]]",
+    ),
     # NaN / inf
     "nan void_height": ("void_height = -2.0", "void_height = nan", "void_height", "nan"),
     "inf resolution": ("resolution = 0.05", "resolution = inf", "resolution", "inf"),
-    "inf center": ("center = [1.0, 1.0, 0.05]", "center = [inf, 1.0, 0.05]", "box[1].center", "[inf, 1.0, 0.05]"),
+    "inf center": (
+        "center = [1.0, 1.0, 0.05]",
+        "center = [inf, 1.0, 0.05]",
+        "box[1].center",
+        "[inf, 1.0, 0.05]",
+    ),
     "nan rpy": ("rpy = [0.0, 0.0, 0.0]", "rpy = [0.0, nan, 0.0]", "box[0].rpy", "[0.0, nan, 0.0]"),
-    "-inf bounds": ("bounds = [[0.0, 0.0], [4.0, 3.0]]", "bounds = [[-inf, 0.0], [4.0, 3.0]]", "bounds",
-                    "[[-inf, 0.0], [4.0, 3.0]]"),
+    "-inf bounds": (
+        "bounds = [[0.0, 0.0], [4.0, 3.0]]",
+        "bounds = [[-inf, 0.0], [4.0, 3.0]]",
+        "bounds",
+        "[[-inf, 0.0], [4.0, 3.0]]",
+    ),
     "nan target": ("target = [3.5, 1.5]", "target = [nan, 1.5]", "scenario.target", "[nan, 1.5]"),
     # heightfield too large: (1000 / 0.1 + 1)^2 = 100 020 001 cells > 50 million
-    "too many cells": ("bounds = [[0.0, 0.0], [4.0, 3.0]]\nvoid_height = -2.0\nresolution = 0.05",
-                       "bounds = [[0.0, 0.0], [1000.0, 1000.0]]\nvoid_height = -2.0\nresolution = 0.1",
-                       "resolution", "0.1"),
+    "too many cells": (
+        "bounds = [[0.0, 0.0], [4.0, 3.0]]\nvoid_height = -2.0\nresolution = 0.05",
+        "bounds = [[0.0, 0.0], [1000.0, 1000.0]]\nvoid_height = -2.0\nresolution = 0.1",
+        "resolution",
+        "0.1",
+    ),
     # unknown keys
     "unknown top-level key": ('name = "unit"', 'name = "unit"\ncolour = "red"', "colour", '"red"'),
     "unknown box key": ("size = [0.5, 0.5, 0.1]", "size = [0.5, 0.5, 0.1]\nmass = 2.0", "box[1].mass", "2.0"),
     "unknown scenario key": ("seed = 0", "seed = 0\ngoal = [1.0, 1.0]", "scenario.goal", "[1.0, 1.0]"),
     # scenario values
-    "start region inverted": ("start_region = [[0.5, 1.0], [1.0, 2.0]]", "start_region = [[1.5, 1.0], [1.0, 2.0]]",
-                              "scenario.start_region", "[[1.5, 1.0], [1.0, 2.0]]"),
-    "yaw range inverted": ("start_yaw_deg = [-30.0, 30.0]", "start_yaw_deg = [30.0, -30.0]",
-                           "scenario.start_yaw_deg", "[30.0, -30.0]"),
-    "negative speed": ("start_speed = [0.0, 0.07]", "start_speed = [-0.1, 0.07]", "scenario.start_speed",
-                       "[-0.1, 0.07]"),
+    "start region inverted": (
+        "start_region = [[0.5, 1.0], [1.0, 2.0]]",
+        "start_region = [[1.5, 1.0], [1.0, 2.0]]",
+        "scenario.start_region",
+        "[[1.5, 1.0], [1.0, 2.0]]",
+    ),
+    "yaw range inverted": (
+        "start_yaw_deg = [-30.0, 30.0]",
+        "start_yaw_deg = [30.0, -30.0]",
+        "scenario.start_yaw_deg",
+        "[30.0, -30.0]",
+    ),
+    "negative speed": (
+        "start_speed = [0.0, 0.07]",
+        "start_speed = [-0.1, 0.07]",
+        "scenario.start_speed",
+        "[-0.1, 0.07]",
+    ),
     "zero starts": ("n_starts = 5", "n_starts = 0", "scenario.n_starts", "0"),
     "negative seed": ("seed = 0", "seed = -1", "scenario.seed", "-1"),
     "target out of bounds": ("target = [3.5, 1.5]", "target = [4.5, 1.5]", "scenario.target", "[4.5, 1.5]"),
     "no waypoints": ("waypoints = [[2.0, 1.5]]", "waypoints = []", "scenario.waypoints", "[]"),
-    "waypoint out of bounds": ("waypoints = [[2.0, 1.5]]", "waypoints = [[2.0, -1.5]]", "scenario.waypoints",
-                               "[[2.0, -1.5]]"),
+    "waypoint out of bounds": (
+        "waypoints = [[2.0, 1.5]]",
+        "waypoints = [[2.0, -1.5]]",
+        "scenario.waypoints",
+        "[[2.0, -1.5]]",
+    ),
 }
 
 
@@ -167,20 +225,20 @@ def test_rejection_names_file_key_and_value(case):
 
 
 def test_no_box_is_rejected():
-    text = BASE[:BASE.index("[[box]]")] + "box = []\n" + BASE[BASE.index("[scenario]"):]
+    text = BASE[: BASE.index("[[box]]")] + "box = []\n" + BASE[BASE.index("[scenario]") :]
     with pytest.raises(TerrainError, match=r"unit\.toml: box = \[\]: needs at least one"):
         loads_terrain(text, SOURCE)
-    text = BASE[:BASE.index("[[box]]")] + BASE[BASE.index("[scenario]"):]
+    text = BASE[: BASE.index("[[box]]")] + BASE[BASE.index("[scenario]") :]
     with pytest.raises(TerrainError, match=r"unit\.toml: box: missing required key"):
         loads_terrain(text, SOURCE)
 
 
 def test_tables_of_the_wrong_kind_are_rejected():
-    head = BASE[:BASE.index("[[box]]")]
+    head = BASE[: BASE.index("[[box]]")]
     with pytest.raises(TerrainError, match=r"^unit\.toml: box = 3: must be an array of tables"):
         loads_terrain("box = 3\n" + head, SOURCE)
     with pytest.raises(TerrainError, match=r"^unit\.toml: scenario = 3: must be a table"):
-        loads_terrain("scenario = 3\n" + BASE[:BASE.index("[scenario]")], SOURCE)
+        loads_terrain("scenario = 3\n" + BASE[: BASE.index("[scenario]")], SOURCE)
 
 
 def test_box_number_is_the_position_in_the_file():

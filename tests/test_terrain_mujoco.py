@@ -41,8 +41,12 @@ def bilinear(heights: np.ndarray, origin, resolution: float, xy: np.ndarray) -> 
     j0 = np.clip(np.floor(grid[:, 1]).astype(int), 0, ny - 2)
     fx, fy = grid[:, 0] - i0, grid[:, 1] - j0
     h = heights.astype(np.float64)
-    return ((1 - fx) * (1 - fy) * h[i0, j0] + fx * (1 - fy) * h[i0 + 1, j0]
-            + (1 - fx) * fy * h[i0, j0 + 1] + fx * fy * h[i0 + 1, j0 + 1])
+    return (
+        (1 - fx) * (1 - fy) * h[i0, j0]
+        + fx * (1 - fy) * h[i0 + 1, j0]
+        + (1 - fx) * fy * h[i0, j0 + 1]
+        + fx * fy * h[i0 + 1, j0 + 1]
+    )
 
 
 def test_bilinear_is_exact_on_a_plane():

@@ -9,15 +9,21 @@ import pytest
 
 from leas_jax.env import EnvConfig, heightfield_from_raster
 from leas_jax.errors import LeasError, UsageError
-from leas_jax.training import TrainConfig, load_policy, preset, train
+from leas_jax.training import TrainConfig, checkpoint, load_policy, preset, train
 from leas_jax.training.config import TRAINING_ENV, TRAINING_REACHABILITY, pretraining_config
-from leas_jax.training import checkpoint
 
 
 def tiny_config(**overrides):
     """A few-second config: 64 envs x 8 steps, 2 iterations per call."""
-    base = dict(num_timesteps=64 * 8 * 2 * 3, num_envs=64, unroll_length=8, num_minibatches=2, num_epochs=2,
-                iterations_per_call=2, checkpoint_every_s=0.0)
+    base = dict(
+        num_timesteps=64 * 8 * 2 * 3,
+        num_envs=64,
+        unroll_length=8,
+        num_minibatches=2,
+        num_epochs=2,
+        iterations_per_call=2,
+        checkpoint_every_s=0.0,
+    )
     return preset("smoke", **{**base, **overrides})
 
 
@@ -32,7 +38,9 @@ def test_presets_and_validation():
     assert preset("paper").num_timesteps == 80_000_000
     assert preset("quick").hidden_sizes == (64, 64)
     # the paper's five reward terms in `paper`; `quick` adds clearance, in both phases and its pretraining
-    assert preset("paper").env.rewards.clearance == 0.0 and preset("paper", mode="planner").env == TRAINING_ENV
+    assert (
+        preset("paper").env.rewards.clearance == 0.0 and preset("paper", mode="planner").env == TRAINING_ENV
+    )
     # every preset trains with the looser TRAINING_REACHABILITY, not the calibrated default
     assert TRAINING_ENV.reachability == TRAINING_REACHABILITY != EnvConfig().reachability
     assert all(preset(name).env.reachability == TRAINING_REACHABILITY for name in ("smoke", "quick", "paper"))
@@ -52,8 +60,16 @@ def test_presets_and_validation():
     # a run saved before the optional terms existed loads with them off, whatever the defaults
     calibrated = preset("paper", env=EnvConfig())
     old = calibrated.to_dict()
-    for key in ("leg_forward", "foothold_radius", "foothold_search", "foothold_spread", "hand_radius",
-                "hand_forward", "hand_lateral", "hand_bottom"):
+    for key in (
+        "leg_forward",
+        "foothold_radius",
+        "foothold_search",
+        "foothold_spread",
+        "hand_radius",
+        "hand_forward",
+        "hand_lateral",
+        "hand_bottom",
+    ):
         del old["env"]["reachability"][key]
     loaded = TrainConfig.from_dict(old).env.reachability
     assert loaded.leg_forward == 0.0 and loaded.hand_radius is None and loaded.foothold_spread is None
@@ -81,7 +97,7 @@ def test_resume_continues_exactly(tmp_path, field):
     for x, y in zip(jax.tree.leaves(a.params), jax.tree.leaves(b.params)):
         np.testing.assert_array_equal(x, y)
     lines = (tmp_path / "split" / "metrics.jsonl").read_text().splitlines()
-    assert [json.loads(l)["iteration"] for l in lines] == [2, 4, 6]
+    assert [json.loads(line)["iteration"] for line in lines] == [2, 4, 6]
     # keep_checkpoints=3: three step files at most, the newest last
     steps = [s for s, _ in checkpoint.list_checkpoints(tmp_path / "split")]
     assert steps[-1] == full.env_steps and len(steps) <= 3

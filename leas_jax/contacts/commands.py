@@ -4,7 +4,7 @@
     leas verify PLAN.npz                      # exit 0: all checks pass, 1: a check fails
     leas show PLAN.npz --out view.html [--png footsteps.png]
 
-File formats are DESIGN §6: a guide file is an `.npz` with `guide` [T, 4]
+File formats are docs/design.md §6: a guide file is an `.npz` with `guide` [T, 4]
 (x, y, z, yaw, world frame), `timestep` (s) and optionally `terrain` (the
 terrain file text) and `target` [2]; a plan file is what `ContactPlan.save`
 writes. Bad input raises `UsageError` naming the argument, file and key;
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-# Keys `ContactPlan.save` writes (DESIGN §6); checked before loading so a
+# Keys `ContactPlan.save` writes (docs/design.md §6); checked before loading so a
 # truncated or foreign file is named with the missing key.
 from leas_jax.contacts.plan import PLAN_KEYS
 from leas_jax.errors import LeasError, UsageError
@@ -31,7 +31,7 @@ from leas_jax.errors import LeasError, UsageError
 
 @dataclass(frozen=True)
 class GuideFile:
-    """Contents of a guide file (DESIGN §6).
+    """Contents of a guide file (docs/design.md §6).
 
     Attributes:
         path: the file.
@@ -56,7 +56,9 @@ def _open_npz(path, argument: str):
     try:
         data = np.load(file, allow_pickle=False)
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-        raise UsageError(f"{argument}: {path}: not a readable .npz file ({type(exc).__name__}: {exc})") from None
+        raise UsageError(
+            f"{argument}: {path}: not a readable .npz file ({type(exc).__name__}: {exc})"
+        ) from None
     if not isinstance(data, np.lib.npyio.NpzFile):
         raise UsageError(f"{argument}: {path}: a single .npy array, expected an .npz archive")
     return data
@@ -70,7 +72,7 @@ def _text(data, path, key: str) -> str:
 
 
 def load_guide_file(path, argument: str = "--guide") -> GuideFile:
-    """Read and check a guide file (DESIGN §6).
+    """Read and check a guide file (docs/design.md §6).
 
     Raises:
         UsageError: missing file or key, wrong shape, NaN/inf, non-positive timestep;
@@ -79,32 +81,49 @@ def load_guide_file(path, argument: str = "--guide") -> GuideFile:
     with _open_npz(path, argument) as data:
         for key in ("guide", "timestep"):
             if key not in data.files:
-                raise UsageError(f"{argument}: {path}: missing key '{key}' (guide files hold guide [T, 4] "
-                                 f"and timestep; found {sorted(data.files)})")
+                raise UsageError(
+                    f"{argument}: {path}: missing key '{key}' (guide files hold guide [T, 4] "
+                    f"and timestep; found {sorted(data.files)})"
+                )
         guide = np.asarray(data["guide"])
         if guide.ndim != 2 or guide.shape[1] != 4 or guide.shape[0] < 1 or guide.dtype.kind not in "fi":
-            raise UsageError(f"{argument}: {path}: key 'guide' must be a [T, 4] number array, "
-                             f"got {guide.dtype} {list(guide.shape)}")
+            raise UsageError(
+                f"{argument}: {path}: key 'guide' must be a [T, 4] number array, "
+                f"got {guide.dtype} {list(guide.shape)}"
+            )
         if not np.isfinite(guide).all():
             raise UsageError(f"{argument}: {path}: key 'guide' contains NaN or inf")
         timestep = np.asarray(data["timestep"])
-        if timestep.size != 1 or timestep.dtype.kind not in "fi" or not np.isfinite(timestep).all() \
-                or float(timestep.reshape(())) <= 0:
-            raise UsageError(f"{argument}: {path}: key 'timestep' must be a positive number of seconds, "
-                             f"got {timestep.tolist()!r}")
+        if (
+            timestep.size != 1
+            or timestep.dtype.kind not in "fi"
+            or not np.isfinite(timestep).all()
+            or float(timestep.reshape(())) <= 0
+        ):
+            raise UsageError(
+                f"{argument}: {path}: key 'timestep' must be a positive number of seconds, "
+                f"got {timestep.tolist()!r}"
+            )
         terrain_text = _text(data, path, "terrain") if "terrain" in data.files else None
         target = None
         if "target" in data.files:
             target = np.asarray(data["target"], dtype=np.float64)
             if target.shape != (2,) or not np.isfinite(target).all():
-                raise UsageError(f"{argument}: {path}: key 'target' must be 2 finite numbers (x, y), "
-                                 f"got {target.tolist()!r}")
-    return GuideFile(path=str(path), guide=guide.astype(np.float64), timestep=float(timestep.reshape(())),
-                     terrain_text=terrain_text, target=target)
+                raise UsageError(
+                    f"{argument}: {path}: key 'target' must be 2 finite numbers (x, y), "
+                    f"got {target.tolist()!r}"
+                )
+    return GuideFile(
+        path=str(path),
+        guide=guide.astype(np.float64),
+        timestep=float(timestep.reshape(())),
+        terrain_text=terrain_text,
+        target=target,
+    )
 
 
 def load_plan_file(path, argument: str = "PLAN"):
-    """Load a plan file with `ContactPlan.load`, after checking it is an .npz with every DESIGN §6 key.
+    """Load a plan file with `ContactPlan.load`, after checking it is an .npz with every docs/design.md §6 key.
 
     Raises:
         UsageError: naming the argument, the file and the first missing key.
@@ -112,8 +131,10 @@ def load_plan_file(path, argument: str = "PLAN"):
     with _open_npz(path, argument) as data:
         missing = [key for key in PLAN_KEYS if key not in data.files]
     if missing:
-        raise UsageError(f"{argument}: {path}: missing key '{missing[0]}' (a plan file written by "
-                         f"ContactPlan.save has {', '.join(PLAN_KEYS)})")
+        raise UsageError(
+            f"{argument}: {path}: missing key '{missing[0]}' (a plan file written by "
+            f"ContactPlan.save has {', '.join(PLAN_KEYS)})"
+        )
     from leas_jax.contacts import ContactPlan
 
     try:
@@ -141,8 +162,10 @@ def _plan_outputs(guide_paths: list[str], out: str) -> list[Path]:
         raise UsageError(f"--out: {out}: directory {out_path.parent} does not exist")
     stems = [Path(p).stem for p in guide_paths]
     if len(set(stems)) != len(stems):
-        raise UsageError(f"--guide: several guide files named {sorted(s for s in stems if stems.count(s) > 1)[0]}"
-                         ".npz would write the same plan file")
+        raise UsageError(
+            f"--guide: several guide files named {sorted(s for s in stems if stems.count(s) > 1)[0]}"
+            ".npz would write the same plan file"
+        )
     out_path.mkdir(exist_ok=True)
     return [out_path / (stem + ".plan.npz") for stem in stems]
 
@@ -154,7 +177,7 @@ def cmd_plan(args) -> int:
         0 when every guide was planned (whatever its coverage), 1 when the
         generator failed on a guide (exception or crashed worker).
     """
-    from leas_jax.contacts.pool import ValidationPool
+    from leas_jax.contacts.validation.pool import ValidationPool
     from leas_jax.contacts.viewer import count_footsteps
     from leas_jax.terrain import load_terrain, loads_terrain
 
@@ -185,16 +208,18 @@ def cmd_plan(args) -> int:
             plan = result.plan
             plan.save(out)
             last = guide.guide.shape[0] - 1
-            print(f"{guide.path}: coverage {result.coverage:.3f}, last_valid_index {result.last_valid_index}/{last}, "
-                  f"footsteps {count_footsteps(plan)}, postures {np.asarray(plan.q).shape[0]}, "
-                  f"time {result.seconds:.2f} s -> {out}")
+            print(
+                f"{guide.path}: coverage {result.coverage:.3f}, last_valid_index {result.last_valid_index}/{last}, "
+                f"footsteps {count_footsteps(plan)}, postures {np.asarray(plan.q).shape[0]}, "
+                f"time {result.seconds:.2f} s -> {out}"
+            )
     if len(guides) > 1:
         print(f"{len(guides)} guides in {time.perf_counter() - start:.2f} s with {pool.workers} workers")
     return status
 
 
 def cmd_verify(args) -> int:
-    """`leas verify`: re-run the DESIGN §6 checks from the plan file alone.
+    """`leas verify`: re-run the docs/design.md §6 checks from the plan file alone.
 
     Prints one line per failing (posture, check) and a summary.
 
@@ -209,8 +234,10 @@ def cmd_verify(args) -> int:
     for posture, check, message in report.failures:
         print(f"posture {posture}: check {check}: {message}")
     if report.ok:
-        print(f"{args.plan}: OK, {count} postures pass all checks "
-              f"(coverage {float(plan.coverage):.3f}, last_valid_index {int(plan.last_valid_index)})")
+        print(
+            f"{args.plan}: OK, {count} postures pass all checks "
+            f"(coverage {float(plan.coverage):.3f}, last_valid_index {int(plan.last_valid_index)})"
+        )
         return 0
     postures = len({failure[0] for failure in report.failures})
     print(f"{args.plan}: FAILED, {len(report.failures)} failed checks in {postures} of {count} postures")
@@ -249,30 +276,48 @@ def _workers(text: str) -> int:
 def register(subparsers) -> None:
     """Add `plan`, `verify` and `show` to the `leas` parser; each sets `func` (args -> exit code)."""
     plan = subparsers.add_parser(
-        "plan", help="contact plan along guide paths",
-        description="Run the Talos contact generator along guide paths (DESIGN §6 guide files) "
-                    "and save the contact plans.")
-    plan.add_argument("--guide", nargs="+", required=True, metavar="GUIDE.npz",
-                      help="guide file(s): guide [T, 4], timestep, optional terrain text and target")
-    plan.add_argument("--terrain", metavar="FILE", help="terrain file (default: the text inside the guide file)")
-    plan.add_argument("--out", required=True, metavar="PLAN.npz",
-                      help="plan file; a directory when several guides are given")
-    plan.add_argument("--workers", type=_workers, default=0,
-                      help="worker processes (default 0: plan in this process)")
+        "plan",
+        help="contact plan along guide paths",
+        description="Run the Talos contact generator along guide paths (docs/design.md §6 guide files) "
+        "and save the contact plans.",
+    )
+    plan.add_argument(
+        "--guide",
+        nargs="+",
+        required=True,
+        metavar="GUIDE.npz",
+        help="guide file(s): guide [T, 4], timestep, optional terrain text and target",
+    )
+    plan.add_argument(
+        "--terrain", metavar="FILE", help="terrain file (default: the text inside the guide file)"
+    )
+    plan.add_argument(
+        "--out",
+        required=True,
+        metavar="PLAN.npz",
+        help="plan file; a directory when several guides are given",
+    )
+    plan.add_argument(
+        "--workers", type=_workers, default=0, help="worker processes (default 0: plan in this process)"
+    )
     plan.set_defaults(func=cmd_plan)
 
     verify = subparsers.add_parser(
-        "verify", help="re-check a contact plan file",
+        "verify",
+        help="re-check a contact plan file",
         description="Re-run every contact-plan check (sole on a support surface, forward kinematics, "
-                    "joint limits, collisions, static equilibrium, one foot moves at a time) from the "
-                    "file alone. Exit code 0: all pass; 1: a check fails.")
+        "joint limits, collisions, static equilibrium, one foot moves at a time) from the "
+        "file alone. Exit code 0: all pass; 1: a check fails.",
+    )
     verify.add_argument("plan", metavar="PLAN.npz")
     verify.set_defaults(func=cmd_verify)
 
     show = subparsers.add_parser(
-        "show", help="3D HTML view of a contact plan",
+        "show",
+        help="3D HTML view of a contact plan",
         description="Write a self-contained 3D HTML view of a contact plan (terrain, guide, footprints, "
-                    "Talos at key postures) and optionally a top-down PNG of the footsteps.")
+        "Talos at key postures) and optionally a top-down PNG of the footsteps.",
+    )
     show.add_argument("plan", metavar="PLAN.npz")
     show.add_argument("--out", metavar="VIEW.html", help="HTML file (default: PLAN.html)")
     show.add_argument("--png", metavar="FILE", help="also write a top-down footsteps PNG")

@@ -1,4 +1,4 @@
-"""Contact plan: the contact generator's output and its file format (DESIGN §6, contract).
+"""Contact plan: the contact generator's output and its file format (docs/design.md §6, contract).
 
 Host-only (NumPy), not jittable.
 """
@@ -11,15 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from leas_jax.contacts.model import NQ
+from leas_jax.contacts.robot.model import NQ
 from leas_jax.errors import LeasError
 
-# Keys of a plan file, DESIGN §6: "exactly those keys plus terrain and guide".
+# Keys of a plan file, docs/design.md §6: "exactly those keys plus terrain and guide".
 PLAN_KEYS = ("q", "feet", "guide_index", "last_valid_index", "coverage", "terrain", "guide")
 
 
 class PlanError(LeasError):
-    """A plan file or plan arrays do not follow the DESIGN §6 format."""
+    """A plan file or plan arrays do not follow the docs/design.md §6 format."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -37,7 +37,7 @@ class ContactPlan:
         terrain: the terrain file text (TOML).
         guide: [T, 4] guide path (x, y, z, yaw), world frame, root = base_link.
         timestep: s between guide poses; kept in memory only (the file holds exactly
-            the DESIGN §6 keys), None for a plan read from a file.
+            the docs/design.md §6 keys), None for a plan read from a file.
     """
 
     q: np.ndarray
@@ -55,8 +55,10 @@ class ContactPlan:
         guide_index = np.asarray(self.guide_index, dtype=np.int64).reshape(-1)
         guide = np.asarray(self.guide, dtype=np.float64).reshape(-1, 4)
         if not (len(q) == len(feet) == len(guide_index)):
-            raise PlanError(f"plan arrays disagree on the posture count: q {len(q)}, feet {len(feet)}, "
-                            f"guide_index {len(guide_index)}")
+            raise PlanError(
+                f"plan arrays disagree on the posture count: q {len(q)}, feet {len(feet)}, "
+                f"guide_index {len(guide_index)}"
+            )
         for name, value in (("q", q), ("feet", feet), ("guide_index", guide_index), ("guide", guide)):
             value.setflags(write=False)
             object.__setattr__(self, name, value)
@@ -79,9 +81,16 @@ class ContactPlan:
         handle, tmp = tempfile.mkstemp(prefix=os.path.basename(path) + ".", suffix=".tmp", dir=folder)
         try:
             with os.fdopen(handle, "wb") as stream:
-                np.savez(stream, q=self.q, feet=self.feet, guide_index=self.guide_index,
-                         last_valid_index=np.int64(self.last_valid_index),
-                         coverage=np.float64(self.coverage), terrain=np.str_(self.terrain), guide=self.guide)
+                np.savez(
+                    stream,
+                    q=self.q,
+                    feet=self.feet,
+                    guide_index=self.guide_index,
+                    last_valid_index=np.int64(self.last_valid_index),
+                    coverage=np.float64(self.coverage),
+                    terrain=np.str_(self.terrain),
+                    guide=self.guide,
+                )
             os.replace(tmp, path)
         except BaseException:
             if os.path.exists(tmp):
@@ -89,7 +98,7 @@ class ContactPlan:
             raise
 
     @classmethod
-    def load(cls, path) -> "ContactPlan":
+    def load(cls, path) -> ContactPlan:
         """Read a plan written by `save`.
 
         Raises:
@@ -98,11 +107,19 @@ class ContactPlan:
         with np.load(path, allow_pickle=False) as data:
             missing = [key for key in PLAN_KEYS if key not in data.files]
             if missing:
-                raise PlanError(f"{path}: missing key '{missing[0]}' (plan files have {', '.join(PLAN_KEYS)})")
+                raise PlanError(
+                    f"{path}: missing key '{missing[0]}' (plan files have {', '.join(PLAN_KEYS)})"
+                )
             try:
-                return cls(q=data["q"], feet=data["feet"], guide_index=data["guide_index"],
-                           last_valid_index=int(data["last_valid_index"]), coverage=float(data["coverage"]),
-                           terrain=str(data["terrain"]), guide=data["guide"])
+                return cls(
+                    q=data["q"],
+                    feet=data["feet"],
+                    guide_index=data["guide_index"],
+                    last_valid_index=int(data["last_valid_index"]),
+                    coverage=float(data["coverage"]),
+                    terrain=str(data["terrain"]),
+                    guide=data["guide"],
+                )
             except ValueError as exc:
                 raise PlanError(f"{path}: malformed plan arrays ({exc})") from None
 
@@ -124,7 +141,7 @@ def arc_length(guide: np.ndarray) -> np.ndarray:
 
 
 def coverage_of(guide: np.ndarray, last_valid_index: int) -> float:
-    """Arc-length fraction of the guide covered up to `last_valid_index` (DESIGN §6).
+    """Arc-length fraction of the guide covered up to `last_valid_index` (docs/design.md §6).
 
     A guide that does not move (pure rotation or standing) has no length; its
     coverage is then the index fraction last_valid_index / (T - 1).

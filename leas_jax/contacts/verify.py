@@ -1,4 +1,4 @@
-"""Verifier: re-run the five checks of DESIGN §6 on a contact plan, from its arrays alone.
+"""Verifier: re-run the five checks of docs/design.md §6 on a contact plan, from its arrays alone.
 
 Host-only (Pinocchio, coal, hpp-centroidal-dynamics), not jittable. Independent of
 the generator's code paths where it matters: forward kinematics and geometry
@@ -7,7 +7,7 @@ support surfaces and collision objects are rebuilt from the terrain text stored 
 the plan (`leas_jax.terrain.loads_terrain`), and equilibrium is hpp-centroidal-
 dynamics' LP on the CoM Pinocchio computes for each saved configuration.
 
-Checks (numbering of DESIGN §6; 0 is the plan's own consistency):
+Checks (numbering of docs/design.md §6; 0 is the plan's own consistency):
     0. arrays: finite q, feet rows all-finite or all-NaN, guide indices in range and
        non-decreasing, last_valid_index / coverage consistent with the guide;
     1. each foot in contact lies flat on a support surface (sole rectangle 0.20 x 0.13 m
@@ -27,13 +27,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from leas_jax.contacts.model import FRICTION, matrix_from_quat_xyzw
+from leas_jax.contacts.robot.model import FRICTION, matrix_from_quat_xyzw
 
-CONTACT_DIST_TOL = 0.005  # m, DESIGN §6 check 1
-CONTACT_ANGLE_TOL = math.radians(3.0)  # rad, DESIGN §6 check 1
+CONTACT_DIST_TOL = 0.005  # m, docs/design.md §6 check 1
+CONTACT_ANGLE_TOL = math.radians(3.0)  # rad, docs/design.md §6 check 1
 CONTACT_EDGE_TOL = 0.005  # m, how far a sole corner may stick out of its face (same 5 mm tolerance)
-FK_TOL = 0.001  # m, DESIGN §6 check 2
-FK_ANGLE_TOL = math.radians(1.0)  # rad, sole orientation from FK vs `feet` (the 1 mm of check 2 over a 0.1 m half-sole is ~0.6 deg)
+FK_TOL = 0.001  # m, docs/design.md §6 check 2
+FK_ANGLE_TOL = math.radians(
+    1.0
+)  # rad, sole orientation from FK vs `feet` (the 1 mm of check 2 over a 0.1 m half-sole is ~0.6 deg)
 JOINT_TOL = 1e-6  # rad, rounding allowance on the joint limits
 SAME_PLACEMENT_TOL = 1e-6  # m (and unit-free on rotation matrices): a foot that stays in place
 
@@ -68,7 +70,7 @@ class VerificationReport:
 
 
 def verify(plan, terrain=None) -> VerificationReport:
-    """Re-run the DESIGN §6 checks on every posture of a plan.
+    """Re-run the docs/design.md §6 checks on every posture of a plan.
 
     Host-only, not jittable.
 
@@ -80,11 +82,11 @@ def verify(plan, terrain=None) -> VerificationReport:
     Returns:
         VerificationReport listing each (posture, check, message) that fails.
     """
-    from leas_jax.contacts.collision import robot_collision, terrain_collision
-    from leas_jax.contacts.equilibrium import HppEquilibrium, sole_corners
-    from leas_jax.contacts.model import load_talos
     from leas_jax.contacts.plan import coverage_of
-    from leas_jax.contacts.surfaces import find_support, surface_arrays
+    from leas_jax.contacts.planner.surfaces import find_support, surface_arrays
+    from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
+    from leas_jax.contacts.robot.equilibrium import HppEquilibrium, sole_corners
+    from leas_jax.contacts.robot.model import load_talos
     from leas_jax.terrain import loads_terrain
 
     if terrain is None:
@@ -112,8 +114,14 @@ def verify(plan, terrain=None) -> VerificationReport:
     if last != expected_last:
         fail.append((-1, 0, f"last_valid_index {last} is not the last posture's guide index {expected_last}"))
     if abs(float(plan.coverage) - coverage_of(guide, last)) > 1e-6:
-        fail.append((-1, 0, f"coverage {float(plan.coverage):.6f} is not the arc-length fraction "
-                            f"{coverage_of(guide, last):.6f} of guide index {last}"))
+        fail.append(
+            (
+                -1,
+                0,
+                f"coverage {float(plan.coverage):.6f} is not the arc-length fraction "
+                f"{coverage_of(guide, last):.6f} of guide index {last}",
+            )
+        )
 
     contact = np.zeros(feet_all.shape[:2], dtype=bool)
     for k in range(len(q_all)):
@@ -132,8 +140,15 @@ def verify(plan, terrain=None) -> VerificationReport:
         # 1. flat on a support surface
         for side in (0, 1):
             if contact[k, side]:
-                index, reason = find_support(terrain, surfaces, feet[side, :3], rotations[side],
-                                             CONTACT_DIST_TOL, CONTACT_ANGLE_TOL, CONTACT_EDGE_TOL)
+                index, reason = find_support(
+                    terrain,
+                    surfaces,
+                    feet[side, :3],
+                    rotations[side],
+                    CONTACT_DIST_TOL,
+                    CONTACT_ANGLE_TOL,
+                    CONTACT_EDGE_TOL,
+                )
                 if index < 0:
                     fail.append((k, 1, f"{_foot(side)}: {reason}"))
 
@@ -145,8 +160,14 @@ def verify(plan, terrain=None) -> VerificationReport:
                 rot_fk = matrix_from_quat_xyzw(soles[side, 3:])
                 angle = _angle_between(rot_fk, rotations[side])
                 if err > FK_TOL or angle > FK_ANGLE_TOL:
-                    fail.append((k, 2, f"{_foot(side)}: FK sole is {1000 * err:.2f} mm and "
-                                       f"{math.degrees(angle):.2f} deg from feet"))
+                    fail.append(
+                        (
+                            k,
+                            2,
+                            f"{_foot(side)}: FK sole is {1000 * err:.2f} mm and "
+                            f"{math.degrees(angle):.2f} deg from feet",
+                        )
+                    )
 
         # 3. joint limits, collisions
         for name, value, lo, hi in talos.joint_limit_violations(q, JOINT_TOL):
@@ -166,9 +187,15 @@ def verify(plan, terrain=None) -> VerificationReport:
             com = talos.com(q)
             robustness = equilibrium.robustness(com)
             if not robustness >= 0.0:
-                fail.append((k, 4, f"not in static equilibrium: robustness {robustness:.4g} < 0 "
-                                   f"(CoM {np.round(com, 4).tolist()}, feet in contact: "
-                                   f"{', '.join(_foot(s) for s in (0, 1) if contact[k, s])})"))
+                fail.append(
+                    (
+                        k,
+                        4,
+                        f"not in static equilibrium: robustness {robustness:.4g} < 0 "
+                        f"(CoM {np.round(com, 4).tolist()}, feet in contact: "
+                        f"{', '.join(_foot(s) for s in (0, 1) if contact[k, s])})",
+                    )
+                )
 
         # 5. one foot at a time, through the air
         if k > 0 and np.all(np.isfinite(q_all[k - 1])):
@@ -179,7 +206,9 @@ def verify(plan, terrain=None) -> VerificationReport:
                     changed.append(side)
                 elif now and not _same_placement(feet_all[k - 1, side], feet[side]):
                     changed.append(side)
-                    fail.append((k, 5, f"{_foot(side)} moves from posture {k - 1} without a posture in the air"))
+                    fail.append(
+                        (k, 5, f"{_foot(side)} moves from posture {k - 1} without a posture in the air")
+                    )
             if len(changed) > 1:
                 fail.append((k, 5, f"both feet change between postures {k - 1} and {k}"))
     return report

@@ -9,7 +9,7 @@ pan, wheel: zoom, slider: posture).
 `write_footsteps_png(plan, path)` draws the terrain heightmap from above with
 the guide, the footprints coloured by foot and the failed guide tail in red.
 
-Both read a plan through the attributes of DESIGN §6: `q [K, 39]`,
+Both read a plan through the attributes of docs/design.md §6: `q [K, 39]`,
 `feet [K, 2, 7]` (xyz + quaternion xyzw of the sole frames, NaN rows for a
 foot in the air), `guide_index [K]`, `last_valid_index`, `coverage`,
 `terrain` (file text, or a `Terrain`) and `guide [T, 4]`.
@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from leas_jax.contacts.model import matrix_from_quat_xyzw
+from leas_jax.contacts.robot.model import matrix_from_quat_xyzw
 
-# Sole rectangle of Talos, centred on the sole frame (DESIGN §6 check 1).
+# Sole rectangle of Talos, centred on the sole frame (docs/design.md §6 check 1).
 SOLE_LENGTH = 0.20  # m, along the sole frame x
 SOLE_WIDTH = 0.13  # m, along the sole frame y
 # Left foot blue, right foot orange in both views (matplotlib tab10).
@@ -76,8 +76,11 @@ def footprints(plan) -> list[tuple[int, int, np.ndarray]]:
             if not np.isfinite(row).all():
                 last[foot] = None
                 continue
-            if last[foot] is not None and np.allclose(row[:3], last[foot][:3], atol=1e-3) \
-                    and np.allclose(row[3:], last[foot][3:], atol=1e-6):
+            if (
+                last[foot] is not None
+                and np.allclose(row[:3], last[foot][:3], atol=1e-3)
+                and np.allclose(row[3:], last[foot][3:], atol=1e-6)
+            ):
                 continue
             last[foot] = row
             rotation = quaternion_xyzw_to_matrix(row[3:])
@@ -103,7 +106,7 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
     Host-only (matplotlib, Agg canvas; does not touch pyplot's global state).
 
     Args:
-        plan: a ContactPlan (DESIGN §6 attributes).
+        plan: a ContactPlan (docs/design.md §6 attributes).
         path: output .png file.
         dpi: resolution of the figure.
     """
@@ -129,9 +132,15 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
     low, high = (float(solid.min()), float(solid.max())) if solid.size else (0.0, 1.0)
     cmap = matplotlib.colormaps["gray"].with_extremes(bad="#0b1a33")
     # heights[i, j] is at (xmin + i*res, ymin + j*res): transpose so rows are y.
-    image = ax.imshow(np.ma.masked_array(heights, void).T, origin="lower", cmap=cmap, interpolation="nearest",
-                      vmin=low - 0.25 - 0.5 * (high - low), vmax=high + 0.05,
-                      extent=(xmin - res / 2, xmax + res / 2, ymin - res / 2, ymax + res / 2))
+    image = ax.imshow(
+        np.ma.masked_array(heights, void).T,
+        origin="lower",
+        cmap=cmap,
+        interpolation="nearest",
+        vmin=low - 0.25 - 0.5 * (high - low),
+        vmax=high + 0.05,
+        extent=(xmin - res / 2, xmax + res / 2, ymin - res / 2, ymax + res / 2),
+    )
     fig.colorbar(image, ax=ax, label="terrain height (m); dark blue: hole", fraction=0.04)
     for foot, _, corners in footprints(plan):
         color = FOOT_COLORS[foot]
@@ -140,7 +149,7 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
     last = int(plan.last_valid_index)
     ok_end = max(0, min(last, guide.shape[0] - 1))
     if last >= 0:
-        ax.plot(guide[:ok_end + 1, 0], guide[:ok_end + 1, 1], color="limegreen", lw=1.5)
+        ax.plot(guide[: ok_end + 1, 0], guide[: ok_end + 1, 1], color="limegreen", lw=1.5)
     if last < guide.shape[0] - 1:
         tail = guide[ok_end:] if last >= 0 else guide
         ax.plot(tail[:, 0], tail[:, 1], color="red", lw=1.5)
@@ -150,14 +159,22 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"{terrain.name}: coverage {float(plan.coverage):.3f}, last valid index {last}, "
-                 f"{count_footsteps(plan)} footsteps", fontsize=10)
-    ax.legend(handles=[
-        Line2D([], [], color="limegreen", label="guide (covered)"),
-        Line2D([], [], color="red", label="guide (failed tail)"),
-        Line2D([], [], color=FOOT_COLORS[0], lw=6, label="left foot"),
-        Line2D([], [], color=FOOT_COLORS[1], lw=6, label="right foot"),
-    ], loc="upper right", fontsize=8, framealpha=0.8)
+    ax.set_title(
+        f"{terrain.name}: coverage {float(plan.coverage):.3f}, last valid index {last}, "
+        f"{count_footsteps(plan)} footsteps",
+        fontsize=10,
+    )
+    ax.legend(
+        handles=[
+            Line2D([], [], color="limegreen", label="guide (covered)"),
+            Line2D([], [], color="red", label="guide (failed tail)"),
+            Line2D([], [], color=FOOT_COLORS[0], lw=6, label="left foot"),
+            Line2D([], [], color=FOOT_COLORS[1], lw=6, label="right foot"),
+        ],
+        loc="upper right",
+        fontsize=8,
+        framealpha=0.8,
+    )
     fig.savefig(str(path), dpi=dpi, bbox_inches="tight")
 
 
@@ -222,7 +239,9 @@ def _talos_visuals(cell: float):
         elif isinstance(shape, coal.Cylinder):
             key = ("cylinder", shape.radius, shape.halfLength)
             if key not in index_of:
-                mesh = trimesh.creation.cylinder(radius=shape.radius, height=2 * shape.halfLength, sections=16)
+                mesh = trimesh.creation.cylinder(
+                    radius=shape.radius, height=2 * shape.halfLength, sections=16
+                )
         elif isinstance(shape, coal.Box):
             key = ("box", *np.asarray(shape.halfSide).tolist())
             if key not in index_of:
@@ -283,8 +302,13 @@ def _b64(array: np.ndarray, dtype) -> str:
     return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
 
 
-def html_payload(plan, *, max_postures: int = DEFAULT_MAX_POSTURES, mesh_cell: float = DEFAULT_MESH_CELL,
-                 robot: bool = True) -> dict:
+def html_payload(
+    plan,
+    *,
+    max_postures: int = DEFAULT_MAX_POSTURES,
+    mesh_cell: float = DEFAULT_MESH_CELL,
+    robot: bool = True,
+) -> dict:
     """The data inlined in the HTML page, as a JSON-ready dict (typed arrays in base64, little-endian).
 
     Keys: name, coverage, last_valid_index, bounds, terrain {positions f32
@@ -307,8 +331,10 @@ def html_payload(plan, *, max_postures: int = DEFAULT_MAX_POSTURES, mesh_cell: f
         "bounds": np.asarray(terrain.bounds, dtype=float).tolist(),
         "terrain": {"positions": _b64(mesh.vertices, "<f4"), "indices": _b64(mesh.faces, "<u4")},
         "guide": _b64(guide[:, :3], "<f4"),
-        "footprints": {FOOT_NAMES[f]: _b64(np.reshape(c, (-1, 3)) if c else np.zeros((0, 3)), "<f4")
-                       for f, c in feet_by_foot.items()},
+        "footprints": {
+            FOOT_NAMES[f]: _b64(np.reshape(c, (-1, 3)) if c else np.zeros((0, 3)), "<f4")
+            for f, c in feet_by_foot.items()
+        },
         "foot_colors": [list(c) for c in FOOT_COLORS],
         "meshes": [],
         "robot": None,
@@ -320,9 +346,13 @@ def html_payload(plan, *, max_postures: int = DEFAULT_MAX_POSTURES, mesh_cell: f
         matrices, drawn = robot_placements(q[chosen], mesh_cell)
         for vertices, faces in meshes:
             small = vertices.shape[0] < 65536  # 16-bit indices halve the largest arrays
-            payload["meshes"].append({"positions": _b64(vertices, "<f4"),
-                                      "indices": _b64(faces, "<u2" if small else "<u4"),
-                                      "index_type": "u16" if small else "u32"})
+            payload["meshes"].append(
+                {
+                    "positions": _b64(vertices, "<f4"),
+                    "indices": _b64(faces, "<u2" if small else "<u4"),
+                    "index_type": "u16" if small else "u32",
+                }
+            )
         payload["robot"] = {
             "geoms": [{"mesh": int(geom_mesh[g]), "color": [float(c) for c in geom_color[g]]} for g in drawn],
             "postures": chosen.tolist(),
@@ -332,8 +362,14 @@ def html_payload(plan, *, max_postures: int = DEFAULT_MAX_POSTURES, mesh_cell: f
     return payload
 
 
-def write_html(plan, path, *, max_postures: int = DEFAULT_MAX_POSTURES, mesh_cell: float = DEFAULT_MESH_CELL,
-               robot: bool = True) -> None:
+def write_html(
+    plan,
+    path,
+    *,
+    max_postures: int = DEFAULT_MAX_POSTURES,
+    mesh_cell: float = DEFAULT_MESH_CELL,
+    robot: bool = True,
+) -> None:
     """Write a self-contained 3D view of the plan (no network, no CDN).
 
     Shows the terrain boxes, the guide (green up to `last_valid_index`, red
@@ -343,7 +379,7 @@ def write_html(plan, path, *, max_postures: int = DEFAULT_MAX_POSTURES, mesh_cel
     adds only 3x4 matrices. Host-only (Pinocchio, trimesh).
 
     Args:
-        plan: a ContactPlan (DESIGN §6 attributes).
+        plan: a ContactPlan (docs/design.md §6 attributes).
         path: output .html file.
         max_postures: key postures whose robot is stored (evenly spread).
         mesh_cell: vertex-clustering cell of the mesh decimation, m.

@@ -7,6 +7,16 @@ from leas_jax.env.wrappers import FreshResetVmap
 
 EnvParams = EnvConfig  # name of the public API (gymnax's `EnvParams` habit)
 
-__all__ = ["EnvConfig", "EnvParams", "HeightmapConfig", "ReachabilityConfig", "RewardWeights",
-           "LeasEnv", "RootState", "Heightfield", "heightfield_from_raster",
-           "heightfield_from_terrain", "FreshResetVmap"]
+__all__ = [
+    "EnvConfig",
+    "EnvParams",
+    "HeightmapConfig",
+    "ReachabilityConfig",
+    "RewardWeights",
+    "LeasEnv",
+    "RootState",
+    "Heightfield",
+    "heightfield_from_raster",
+    "heightfield_from_terrain",
+    "FreshResetVmap",
+]

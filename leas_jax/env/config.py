@@ -1,20 +1,19 @@
 """Static configuration of the LeaS environment.
 
-Every default is the paper's value or the one DESIGN.md §5 gives, with its
+Every default is the paper's value or the one docs/design.md §5 gives, with its
 unit and source. These dataclasses are frozen and hashable: they fix shapes
 and are baked into compiled code (gymnax's static `EnvParams` habit).
 """
 
-from dataclasses import dataclass, field
-
 import math
+from dataclasses import dataclass, field
 
 
 @dataclass(frozen=True)
 class ReachabilityConfig:
     """Cylinders of the reachability condition, root frame (origin at base_link, z up, yaw only).
 
-    DESIGN.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
+    docs/design.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
     Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]). The
     defaults below were calibrated by benchmarks/reachability_calibration.py against
     the contact generator *walking* (`--truth walking --poses 48000`: a pose is feasible
@@ -35,21 +34,23 @@ class ReachabilityConfig:
     generator" section has the figures and their history.
     """
 
-    # m, trunk cylinder radius: calibrated (DESIGN §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)
+    # m, trunk cylinder radius: calibrated (docs/design.md §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)
     trunk_radius: float = 0.30
     # m below the root: calibrated; the root stays 0.475 m above everything within
-    # trunk_radius (DESIGN §5: -0.63, the hip; -0.70 in the 12 000-pose calibration); leg_top
+    # trunk_radius (docs/design.md §5: -0.63, the hip; -0.70 in the 12 000-pose calibration); leg_top
     # keeps it 0.75 m above the ground under the legs, the hands term clear beside it
     trunk_bottom: float = -0.475
     trunk_top: float = 0.60  # m above the root: head (no effect on a heightfield, which has no overhangs)
-    # m, radius of each leg cylinder: calibrated (DESIGN §5: 0.25, talos_*leg_rom); the generator
+    # m, radius of each leg cylinder: calibrated (docs/design.md §5: 0.25, talos_*leg_rom); the generator
     # needs ground near the nominal sole place, so a wide disk over-accepts
     leg_radius: float = 0.05
     leg_lateral_offset: float = 0.085  # m, leg cylinder centres at (0, ±offset) in the root frame
-    # m below the root: lowest reachable sole height, calibrated (DESIGN §5: -1.06); the generator
+    # m below the root: lowest reachable sole height, calibrated (docs/design.md §5: -1.06); the generator
     # stands up to ~1.18 m above the soles (root lowered by at most 0.10 m)
     leg_bottom: float = -1.175
-    leg_top: float = -0.75  # m below the root: highest reachable sole height, calibrated (DESIGN §5: -0.54)
+    leg_top: float = (
+        -0.75
+    )  # m below the root: highest reachable sole height, calibrated (docs/design.md §5: -0.54)
     # Optional terms (benchmarks/reachability_false_positives.py, issue 3 item 6). The
     # calibration turns all three on.
     # m, lookahead: a second pair of leg cylinders at (leg_forward, ±leg_lateral_offset) in the
@@ -115,7 +116,7 @@ class RewardWeights:
 
 @dataclass(frozen=True)
 class EnvConfig:
-    """LeaS MDP parameters (DESIGN.md §5)."""
+    """LeaS MDP parameters (docs/design.md §5)."""
 
     timestep: float = 0.10  # s, paper Table I
     episode_length: int = 400  # steps, paper Table I
@@ -138,7 +139,7 @@ class EnvConfig:
     # puts base_link about 1.0 m above its soles (measured on the
     # example-robot-data model by leas_jax.contacts).
     nominal_root_height: float = 1.0  # m
-    target_reached_distance: float = 0.20  # m, epsilon of the evaluation termination (DESIGN §5)
+    target_reached_distance: float = 0.20  # m, epsilon of the evaluation termination (docs/design.md §5)
     stop_at_target: bool = False  # evaluation mode: end an episode when the root is within epsilon
     # m, shift of the clearance term's six probe poses (used when rewards.clearance != 0);
     # 0.10 m kept quick policies' arena validity >= 92 % at two training seeds where 0.08 m

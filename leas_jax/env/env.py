@@ -64,7 +64,7 @@ def _heading(yaw: jax.Array) -> jax.Array:
 
 
 class LeasEnv(Env):
-    """LeaS guide-path environment (paper §III, DESIGN.md §5).
+    """LeaS guide-path environment (paper §III, docs/design.md §5).
 
     Observation [81]: root-frame velocity [3], target angle [1] (target
     direction minus heading, wrapped to [-pi, pi)), heightmap [77].
@@ -78,7 +78,7 @@ class LeasEnv(Env):
         self.field = field
         self.config = config
 
-    def with_field(self, field: Heightfield) -> "LeasEnv":
+    def with_field(self, field: Heightfield) -> LeasEnv:
         """The same env on another (possibly traced) heightfield."""
         return LeasEnv(field, self.config)
 
@@ -103,11 +103,24 @@ class LeasEnv(Env):
         return jnp.concatenate([vel_root, target_angle[None], hmap])
 
     def _state(self, root: RootState, reward_value, done, metrics, truncation) -> State:
-        return State(pipeline_state=root, obs=self.observe(root), reward=reward_value, done=done,
-                     metrics=metrics, info={"truncation": truncation})
+        return State(
+            pipeline_state=root,
+            obs=self.observe(root),
+            reward=reward_value,
+            done=done,
+            metrics=metrics,
+            info={"truncation": truncation},
+        )
 
     def _zero_metrics(self) -> dict:
-        names = ("direction", "orientation", "effort_orientation", "effort_acceleration", "alive", "clearance")
+        names = (
+            "direction",
+            "orientation",
+            "effort_orientation",
+            "effort_acceleration",
+            "alive",
+            "clearance",
+        )
         metrics = {f"reward/{n}": jnp.zeros(()) for n in names}
         metrics.update(invalid=jnp.zeros(()), reached=jnp.zeros(()))
         return metrics
@@ -129,7 +142,7 @@ class LeasEnv(Env):
         next_rng, key = jax.random.split(rng)
         n = cfg.reset_attempts
         u = jax.random.uniform(key, (4 * n + 2,))
-        cand, speed_u, target_u = u[:4 * n].reshape(n, 4), u[-2], u[-1]
+        cand, speed_u, target_u = u[: 4 * n].reshape(n, 4), u[-2], u[-1]
         count = self.field.spawn_xy.shape[0]
         idx = jnp.minimum((cand[:, 0] * count).astype(jnp.int32), count - 1)
         jitter = (cand[:, 1:3] - 0.5) * self.field.spawn_spacing
@@ -143,13 +156,26 @@ class LeasEnv(Env):
         ok = ok | last  # spawn points are valid for every yaw by construction
         pose = poses[jnp.argmax(ok)]
         target_angle = (2.0 * target_u - 1.0) * jnp.pi
-        return self._root(pose, speed_u * cfg.reset_max_speed, _heading(target_angle), jnp.zeros(2),
-                          jnp.asarray(False), next_rng)
+        return self._root(
+            pose,
+            speed_u * cfg.reset_max_speed,
+            _heading(target_angle),
+            jnp.zeros(2),
+            jnp.asarray(False),
+            next_rng,
+        )
 
     def _root(self, pose, speed, target_dir, target_point, follow_point, rng) -> RootState:
-        return RootState(pos=pose[:3], vel=jnp.concatenate([speed * _heading(pose[3]), jnp.zeros(1)]),
-                         yaw=pose[3], target_dir=target_dir, target_point=target_point,
-                         follow_point=follow_point, steps=jnp.zeros((), jnp.int32), rng=rng)
+        return RootState(
+            pos=pose[:3],
+            vel=jnp.concatenate([speed * _heading(pose[3]), jnp.zeros(1)]),
+            yaw=pose[3],
+            target_dir=target_dir,
+            target_point=target_point,
+            follow_point=follow_point,
+            steps=jnp.zeros((), jnp.int32),
+            rng=rng,
+        )
 
     def reset_to(self, pose: jax.Array, speed, target_dir=None, target_point=None, rng=None) -> State:
         """Start from a given pose.
@@ -167,8 +193,14 @@ class LeasEnv(Env):
         follow = target_point is not None
         point = jnp.asarray(target_point if follow else jnp.zeros(2), jnp.float32)
         direction = _unit(point - pose[:2]) if follow else _unit(jnp.asarray(target_dir, jnp.float32))
-        root = self._root(pose, jnp.asarray(speed, jnp.float32), direction, point, jnp.asarray(follow),
-                          jax.random.PRNGKey(0) if rng is None else rng)
+        root = self._root(
+            pose,
+            jnp.asarray(speed, jnp.float32),
+            direction,
+            point,
+            jnp.asarray(follow),
+            jax.random.PRNGKey(0) if rng is None else rng,
+        )
         return self._state(root, jnp.zeros(()), jnp.zeros(()), self._zero_metrics(), jnp.zeros(()))
 
     # -- step --------------------------------------------------------------
@@ -191,10 +223,14 @@ class LeasEnv(Env):
 
         terms = reward.terms(vel, yaw, action, target_dir, cfg)
         ok = reachability.valid(self.field, root.pose, cfg.reachability)
-        terms["clearance"] = (-reachability.clearance_shortfall(self.field, root.pose, cfg.clearance_margin,
-                                                                 cfg.reachability)
-                              if cfg.rewards.clearance != 0.0 else jnp.zeros(()))
-        reached = root.follow_point & (jnp.linalg.norm(root.target_point - pos[:2]) < cfg.target_reached_distance)
+        terms["clearance"] = (
+            -reachability.clearance_shortfall(self.field, root.pose, cfg.clearance_margin, cfg.reachability)
+            if cfg.rewards.clearance != 0.0
+            else jnp.zeros(())
+        )
+        reached = root.follow_point & (
+            jnp.linalg.norm(root.target_point - pos[:2]) < cfg.target_reached_distance
+        )
         reached = reached & cfg.stop_at_target
         timeout = steps >= cfg.episode_length
         done = (~ok) | reached | timeout

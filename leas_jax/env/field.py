@@ -11,9 +11,9 @@ terrain is `void_height` (the void the boxes stand over).
 
 from __future__ import annotations
 
-import numpy as np
 import jax
 import jax.numpy as jnp
+import numpy as np
 from flax import struct
 from scipy import ndimage
 
@@ -111,8 +111,7 @@ def sample_bilinear(field: Heightfield, xy: jax.Array) -> jax.Array:
     h01 = flat[base + 1]
     h10 = flat[base + ny]
     h11 = flat[base + ny + 1]
-    h = (h00 * (1 - fu) * (1 - fv) + h10 * fu * (1 - fv)
-         + h01 * (1 - fu) * fv + h11 * fu * fv)
+    h = h00 * (1 - fu) * (1 - fv) + h10 * fu * (1 - fv) + h01 * (1 - fu) * fv + h11 * fu * fv
     return jnp.where(inside, h, field.void_height)
 
 
@@ -140,7 +139,7 @@ def disk_filter(heights: np.ndarray, radius_cells: float, reduce: str, cval: flo
     for dy in range(-r, r + 1):
         half = int(np.floor(np.sqrt(max(radius_cells**2 - dy**2, 0.0))))
         rows = filt1d(padded, size=2 * half + 1, axis=0, mode="constant", cval=cval)
-        shifted = rows[r:-r or None, r + dy: r + dy + heights.shape[1]]
+        shifted = rows[r : -r or None, r + dy : r + dy + heights.shape[1]]
         out = shifted if out is None else combine(out, shifted)
     return out
 
@@ -150,8 +149,9 @@ def _solid(heights: np.ndarray, void_height: float, fill: float) -> np.ndarray:
     return np.where(heights > void_height + 1e-6, heights, fill)
 
 
-def foothold_raster(heights: np.ndarray, void_height: float, resolution: float, foothold_radius: float,
-                    foothold_search: float) -> np.ndarray:
+def foothold_raster(
+    heights: np.ndarray, void_height: float, resolution: float, foothold_radius: float, foothold_search: float
+) -> np.ndarray:
     """Flatness of the best sole place near every grid point (host, NumPy).
 
     spread[p] = max - min of the terrain heights over the disk of radius `foothold_radius`
@@ -176,8 +176,15 @@ def foothold_raster(heights: np.ndarray, void_height: float, resolution: float, 
     return disk_filter(spread, foothold_search / resolution, "min", np.inf).astype(np.float32)
 
 
-def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float, resolution: float,
-                  config: EnvConfig, spacing: float, foothold: np.ndarray | None = None) -> np.ndarray:
+def _spawn_points(
+    heights: np.ndarray,
+    trunk_max: np.ndarray,
+    void_height: float,
+    resolution: float,
+    config: EnvConfig,
+    spacing: float,
+    foothold: np.ndarray | None = None,
+) -> np.ndarray:
     """Grid indices [S, 2] where a root at nominal height is valid for every yaw.
 
     The leg cylinders turn with the yaw around the root, their centres `farthest` m
@@ -212,7 +219,9 @@ def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float
     if foothold is not None:
         ok &= disk_filter(foothold, farthest / resolution, "max", np.inf) <= reach.foothold_spread
     if reach.hand_radius is not None:
-        hands = (float(np.hypot(reach.hand_forward, reach.hand_lateral)) + reach.hand_radius + resolution) / resolution
+        hands = (
+            float(np.hypot(reach.hand_forward, reach.hand_lateral)) + reach.hand_radius + resolution
+        ) / resolution
         ok &= disk_filter(heights, hands, "max", void_height) < z + reach.hand_bottom
     # keep away from the grid border so that jittered resets stay inside
     ok[:stride, :] = ok[-stride:, :] = False
@@ -222,9 +231,15 @@ def _spawn_points(heights: np.ndarray, trunk_max: np.ndarray, void_height: float
     return np.argwhere(ok & sub)
 
 
-def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void_height: float,
-                            config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10,
-                            require_spawn: bool = True) -> Heightfield:
+def heightfield_from_raster(
+    heights: np.ndarray,
+    origin,
+    resolution: float,
+    void_height: float,
+    config: EnvConfig = EnvConfig(),
+    spawn_spacing: float = 0.10,
+    require_spawn: bool = True,
+) -> Heightfield:
     """Build the JAX heightfield and its reachability rasters (host only, not jittable).
 
     Args:
@@ -242,14 +257,21 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
     trunk_max = disk_filter(heights, reach.trunk_radius / resolution, "max", void_height)
     # legs touch solid terrain only: the void is ignored (-inf for the max, +inf for the min),
     # so a disk over the void alone never touches, whatever the root height
-    leg_max = disk_filter(_solid(heights, void_height, -np.inf), reach.leg_radius / resolution, "max", -np.inf)
+    leg_max = disk_filter(
+        _solid(heights, void_height, -np.inf), reach.leg_radius / resolution, "max", -np.inf
+    )
     leg_min = disk_filter(_solid(heights, void_height, np.inf), reach.leg_radius / resolution, "min", np.inf)
     if reach.foothold_spread is None:
         foothold = None
     else:
-        foothold = foothold_raster(heights, void_height, resolution, reach.foothold_radius, reach.foothold_search)
-    hand_max = None if reach.hand_radius is None else disk_filter(heights, reach.hand_radius / resolution, "max",
-                                                                   void_height)
+        foothold = foothold_raster(
+            heights, void_height, resolution, reach.foothold_radius, reach.foothold_search
+        )
+    hand_max = (
+        None
+        if reach.hand_radius is None
+        else disk_filter(heights, reach.hand_radius / resolution, "max", void_height)
+    )
     spawn_ij = _spawn_points(heights, trunk_max, void_height, resolution, config, spawn_spacing, foothold)
     if len(spawn_ij) == 0:
         if require_spawn:
@@ -258,15 +280,24 @@ def heightfield_from_raster(heights: np.ndarray, origin, resolution: float, void
     spawn_xy = np.asarray(origin, dtype=np.float32) + spawn_ij.astype(np.float32) * resolution
     f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
     return Heightfield(
-        heights=f32(heights), trunk_max=f32(trunk_max), leg_max=f32(leg_max), leg_min=f32(leg_min),
+        heights=f32(heights),
+        trunk_max=f32(trunk_max),
+        leg_max=f32(leg_max),
+        leg_min=f32(leg_min),
         foothold=f32(np.zeros((1, 1)) if foothold is None else foothold),
         hand_max=f32(np.zeros((1, 1)) if hand_max is None else hand_max),
-        origin=f32(origin), resolution=f32(resolution), void_height=f32(void_height),
-        spawn_xy=f32(spawn_xy), spawn_spacing=f32(spawn_spacing),
+        origin=f32(origin),
+        resolution=f32(resolution),
+        void_height=f32(void_height),
+        spawn_xy=f32(spawn_xy),
+        spawn_spacing=f32(spawn_spacing),
     )
 
 
-def heightfield_from_terrain(terrain, config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10) -> Heightfield:
+def heightfield_from_terrain(
+    terrain, config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10
+) -> Heightfield:
     """Heightfield of a `leas_jax.terrain.Terrain` (host only, not jittable)."""
-    return heightfield_from_raster(terrain.raster(), terrain.bounds[0], terrain.resolution,
-                                   terrain.void_height, config, spawn_spacing)
+    return heightfield_from_raster(
+        terrain.raster(), terrain.bounds[0], terrain.resolution, terrain.void_height, config, spawn_spacing
+    )

@@ -1,8 +1,8 @@
 """The local heightmap of the observation (paper §III-B, Fig. 3). Pure and jittable."""
 
-import numpy as np
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from leas_jax.env.config import HeightmapConfig
 from leas_jax.env.field import Heightfield, sample_bilinear

@@ -38,8 +38,9 @@ def scale_action(action: jax.Array, yaw: jax.Array, config: EnvConfig):
     return accel, action[3] * config.omega_max
 
 
-def integrate(pos: jax.Array, vel: jax.Array, yaw: jax.Array, accel: jax.Array,
-              omega: jax.Array, config: EnvConfig):
+def integrate(
+    pos: jax.Array, vel: jax.Array, yaw: jax.Array, accel: jax.Array, omega: jax.Array, config: EnvConfig
+):
     """One step of the paper's update, eqs (1)-(3).
 
     pos_i = pos_{i-1} + vel_{i-1} dt                   (1)

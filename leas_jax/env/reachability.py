@@ -1,4 +1,4 @@
-"""Reachability condition of a root pose (DESIGN.md §5). Pure and jittable.
+"""Reachability condition of a root pose (docs/design.md §5). Pure and jittable.
 
 A pose is valid when
   - the trunk is collision-free: no terrain inside the vertical cylinder of
@@ -59,15 +59,19 @@ def all_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityCo
 
 def hand_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
     """World (x, y) of the hand disks, [2, 2] (left, right). pose: [4] (x, y, z, yaw), world."""
-    offsets = jnp.array([[config.hand_forward, config.hand_lateral], [config.hand_forward, -config.hand_lateral]])
+    offsets = jnp.array(
+        [[config.hand_forward, config.hand_lateral], [config.hand_forward, -config.hand_lateral]]
+    )
     return pose[:2] + rotate_z(offsets, pose[3])
 
 
 def _term_raster(field: Heightfield, raster: jax.Array, term: str) -> jax.Array:
     """The raster of an enabled optional term; ValueError if the field was built without it."""
     if raster.shape != field.heights.shape:
-        raise ValueError(f"the {term} term is enabled but the heightfield has no {term} raster: "
-                         "build it with the same ReachabilityConfig")
+        raise ValueError(
+            f"the {term} term is enabled but the heightfield has no {term} raster: "
+            "build it with the same ReachabilityConfig"
+        )
     return raster
 
 
@@ -96,29 +100,48 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
     if config.foothold_spread is None:
         foothold = (yes, yes)
     else:
-        flat = sample_nearest(field, _term_raster(field, field.foothold, "foothold"), legs,
-                              outside=jnp.inf) <= config.foothold_spread
+        flat = (
+            sample_nearest(field, _term_raster(field, field.foothold, "foothold"), legs, outside=jnp.inf)
+            <= config.foothold_spread
+        )
         flat = flat.reshape(-1, 2).all(axis=0)  # [2]: left, right (over the leg and its lookahead leg)
         foothold = (flat[0], flat[1])
     if config.hand_radius is None:
         hands = (yes, yes)
     else:
-        free = sample_nearest(field, _term_raster(field, field.hand_max, "hand"), hand_centers(pose, config),
-                              outside=-jnp.inf) < z + config.hand_bottom
+        free = (
+            sample_nearest(
+                field,
+                _term_raster(field, field.hand_max, "hand"),
+                hand_centers(pose, config),
+                outside=-jnp.inf,
+            )
+            < z + config.hand_bottom
+        )
         hands = (free[0], free[1])
-    return {"trunk_free": trunk_free, "left_touch": touch[0], "right_touch": touch[1],
-            "left_ahead_touch": ahead[0], "right_ahead_touch": ahead[1],
-            "left_foothold": foothold[0], "right_foothold": foothold[1],
-            "left_hand_free": hands[0], "right_hand_free": hands[1]}
+    return {
+        "trunk_free": trunk_free,
+        "left_touch": touch[0],
+        "right_touch": touch[1],
+        "left_ahead_touch": ahead[0],
+        "right_ahead_touch": ahead[1],
+        "left_foothold": foothold[0],
+        "right_foothold": foothold[1],
+        "left_hand_free": hands[0],
+        "right_hand_free": hands[1],
+    }
 
 
-def valid(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
+def valid(
+    field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()
+) -> jax.Array:
     """True when the root pose satisfies the reachability condition. pose: [4] -> bool[]."""
     return jnp.all(jnp.stack(list(terms(field, pose, config).values())))
 
 
-def clearance_shortfall(field: Heightfield, pose: jax.Array, margin: float,
-                        config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
+def clearance_shortfall(
+    field: Heightfield, pose: jax.Array, margin: float, config: ReachabilityConfig = ReachabilityConfig()
+) -> jax.Array:
     """Fraction of the six poses shifted by `margin` (m) along the root frame's x, y and z
     axes, both ways, that violate the condition: 0 when the pose keeps `margin` of room in
     every direction, up to 1. pose: [4] (x, y, z, yaw), world -> float[]."""

@@ -6,8 +6,9 @@ import jax.numpy as jnp
 from leas_jax.env.config import EnvConfig
 
 
-def terms(vel: jax.Array, yaw: jax.Array, action: jax.Array, target_dir: jax.Array,
-          config: EnvConfig) -> dict:
+def terms(
+    vel: jax.Array, yaw: jax.Array, action: jax.Array, target_dir: jax.Array, config: EnvConfig
+) -> dict:
     """Named reward terms, unweighted.
 
     Args:
@@ -30,9 +31,9 @@ def terms(vel: jax.Array, yaw: jax.Array, action: jax.Array, target_dir: jax.Arr
     desired = jnp.concatenate([config.target_speed * target_dir, jnp.zeros(1)])
     heading = jnp.stack([jnp.cos(yaw), jnp.sin(yaw)])
     return {
-        "direction": -(jnp.linalg.norm(vel - desired) / (2.0 * config.v_max)) ** 2,
+        "direction": -((jnp.linalg.norm(vel - desired) / (2.0 * config.v_max)) ** 2),
         "orientation": -(1.0 - jnp.dot(heading, target_dir)),
-        "effort_orientation": -action[3] ** 2,
+        "effort_orientation": -(action[3] ** 2),
         "effort_acceleration": -jnp.sum(action[:3] ** 2),
         "alive": jnp.ones(()),
     }
@@ -41,8 +42,12 @@ def terms(vel: jax.Array, yaw: jax.Array, action: jax.Array, target_dir: jax.Arr
 def total(reward_terms: dict, config: EnvConfig) -> jax.Array:
     """Weighted sum of the terms with the paper's Table I weights."""
     w = config.rewards
-    weights = {"direction": w.direction, "orientation": w.orientation,
-               "effort_orientation": w.effort_orientation,
-               "effort_acceleration": w.effort_acceleration, "alive": w.alive,
-               "clearance": w.clearance}
+    weights = {
+        "direction": w.direction,
+        "orientation": w.orientation,
+        "effort_orientation": w.effort_orientation,
+        "effort_acceleration": w.effort_acceleration,
+        "alive": w.alive,
+        "clearance": w.clearance,
+    }
     return sum(weights[name] * value for name, value in reward_terms.items())

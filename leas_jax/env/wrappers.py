@@ -2,7 +2,7 @@
 
 Brax's `AutoResetWrapper` restores the *first* state of each env after an
 episode ends, so every env would replay the same start. LeaS needs a fresh
-random start per episode (DESIGN.md §5): `FreshResetVmap` draws a new start
+random start per episode (docs/design.md §5): `FreshResetVmap` draws a new start
 with the key carried in the state whenever an episode ends.
 
 The wrapper knows `LeasEnv`'s parts: it selects between the stepped and the
@@ -44,8 +44,11 @@ def fresh_roots(env, root, done: jax.Array):
     count = done.sum()
 
     def select(fresh):
-        return jax.tree.map(lambda new, old: jnp.where(done.reshape(done.shape + (1,) * (old.ndim - 1)), new, old),
-                            fresh, root)
+        return jax.tree.map(
+            lambda new, old: jnp.where(done.reshape(done.shape + (1,) * (old.ndim - 1)), new, old),
+            fresh,
+            root,
+        )
 
     def gathered(capacity):
         def branch(root):
@@ -55,6 +58,7 @@ def fresh_roots(env, root, done: jax.Array):
             drawn = jax.vmap(env.random_root)(root.rng[idx])  # [capacity]
             slot = jnp.clip(jnp.cumsum(done) - 1, 0, capacity - 1)  # [B] rank of each finished env
             return select(jax.tree.map(lambda x: x[slot], drawn))
+
         return branch
 
     capacities = reset_capacities(batch)
@@ -81,5 +85,11 @@ class FreshResetVmap(Wrapper):
         env = self.env.unwrapped
         root, reward_value, done, metrics, truncation = jax.vmap(env.transition)(state.pipeline_state, action)
         root = fresh_roots(env, root, done > 0)
-        return state.replace(pipeline_state=root, obs=jax.vmap(env.observe)(root), reward=reward_value, done=done,
-                             metrics=metrics, info={**state.info, "truncation": truncation})
+        return state.replace(
+            pipeline_state=root,
+            obs=jax.vmap(env.observe)(root),
+            reward=reward_value,
+            done=done,
+            metrics=metrics,
+            info={**state.info, "truncation": truncation},
+        )

@@ -35,8 +35,9 @@ def parse_seeds(text: str) -> tuple[int, ...]:
     return seeds
 
 
-def arena_check(checkpoint, episodes: int = 2048, seeds=(0, 1), ground_episodes: int = 256, terrain_file=None,
-                out=None) -> dict:
+def arena_check(
+    checkpoint, episodes: int = 2048, seeds=(0, 1), ground_episodes: int = 256, terrain_file=None, out=None
+) -> dict:
     """Speed, safety and failure breakdown of a policy.
 
     Args:
@@ -68,29 +69,43 @@ def arena_check(checkpoint, episodes: int = 2048, seeds=(0, 1), ground_episodes:
     field = heightfield_from_terrain(arena, env)
     ground = load_terrain(resolve_data_path("terrains/eval_ground.toml"))
     speed = ground_speed(policy, ground, heightfield_from_terrain(ground, env), n=ground_episodes, seed=2)
-    report = {"format": "leas-arena-check-v1",
-              "policy": {"source": policy.source, "env_steps": int(policy.env_steps), "preset": policy.config.preset,
-                         "seed": policy.config.seed},
-              "terrain": arena.path or arena.name, "episodes": episodes,
-              "targets": {"ground_mean_speed": GROUND_SPEED_TARGET, "arena_valid_fraction": ARENA_VALID_TARGET},
-              "ground": {"episodes": ground_episodes, "mean_speed": speed.mean_speed,
-                         "invalid_fraction": speed.invalid_fraction},
-              "arena": {}}
+    report = {
+        "format": "leas-arena-check-v1",
+        "policy": {
+            "source": policy.source,
+            "env_steps": int(policy.env_steps),
+            "preset": policy.config.preset,
+            "seed": policy.config.seed,
+        },
+        "terrain": arena.path or arena.name,
+        "episodes": episodes,
+        "targets": {"ground_mean_speed": GROUND_SPEED_TARGET, "arena_valid_fraction": ARENA_VALID_TARGET},
+        "ground": {
+            "episodes": ground_episodes,
+            "mean_speed": speed.mean_speed,
+            "invalid_fraction": speed.invalid_fraction,
+        },
+        "arena": {},
+    }
     first = None
     for seed in seeds:
         result = arena_episodes(policy, field, n=episodes, seed=seed)
         first = first or result
         report["arena"][str(seed)] = {
-            "valid_fraction": result.valid_fraction, "stopped_fraction_of_valid": result.stopped_fraction,
+            "valid_fraction": result.valid_fraction,
+            "stopped_fraction_of_valid": result.stopped_fraction,
             "mean_progress_m": result.mean_progress,
-            "failures": dataclasses.asdict(failure_breakdown(field, result, env.reachability))}
+            "failures": dataclasses.asdict(failure_breakdown(field, result, env.reachability)),
+        }
     report["seconds"] = round(time.perf_counter() - began, 3)
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         (out / "arena_check.json").write_text(json.dumps(report, indent=1) + "\n")
         (out / "arena_check.md").write_text(markdown(report))
-        failures_figure(arena, field, first, out / "arena_failures.png", seed=seeds[0], config=env.reachability)
+        failures_figure(
+            arena, field, first, out / "arena_failures.png", seed=seeds[0], config=env.reachability
+        )
     return report
 
 
@@ -102,17 +117,25 @@ def markdown(report: dict) -> str:
     """The figures of an `arena_check` report as a Markdown table and a failure breakdown per seed."""
     targets, ground = report["targets"], report["ground"]
     policy = report["policy"]
-    lines = [f"Policy `{policy['source']}` ({policy['env_steps']:,} env steps, preset `{policy['preset']}`, "
-             f"seed {policy['seed']}); arena `{report['terrain']}`.", "",
-             "| metric (deterministic policy) | value | target |", "|---|---|---|",
-             f"| eval_ground: mean speed along the target direction, 400 steps, random headings "
-             f"({ground['episodes']} episodes) | {ground['mean_speed']:.3f} m/s | >= {targets['ground_mean_speed']} |"]
+    lines = [
+        f"Policy `{policy['source']}` ({policy['env_steps']:,} env steps, preset `{policy['preset']}`, "
+        f"seed {policy['seed']}); arena `{report['terrain']}`.",
+        "",
+        "| metric (deterministic policy) | value | target |",
+        "|---|---|---|",
+        f"| eval_ground: mean speed along the target direction, 400 steps, random headings "
+        f"({ground['episodes']} episodes) | {ground['mean_speed']:.3f} m/s | >= {targets['ground_mean_speed']} |",
+    ]
     for seed, arena in report["arena"].items():
-        lines.append(f"| arena: episodes without an invalid pose ({report['episodes']} episodes, seed {seed}) "
-                     f"| {100 * arena['valid_fraction']:.1f} % | >= {100 * targets['arena_valid_fraction']:.0f} % |")
+        lines.append(
+            f"| arena: episodes without an invalid pose ({report['episodes']} episodes, seed {seed}) "
+            f"| {100 * arena['valid_fraction']:.1f} % | >= {100 * targets['arena_valid_fraction']:.0f} % |"
+        )
     lines += ["", "Episodes that end invalid (first invalid pose):", ""]
-    lines += [f"- seed {seed}: {failures_line(FailureBreakdown(**arena['failures']))}"
-              for seed, arena in report["arena"].items()]
+    lines += [
+        f"- seed {seed}: {failures_line(FailureBreakdown(**arena['failures']))}"
+        for seed, arena in report["arena"].items()
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -120,9 +143,11 @@ def failures_line(failures) -> str:
     """One Markdown sentence of a `FailureBreakdown`."""
     if failures.invalid == 0:
         return "none."
-    return (f"{failures.invalid} episodes. Failed terms: {_counts(failures.terms)}. Terrain in the trunk cylinder: "
-            f"{_counts(failures.trunk_bearing)}. Motion: {_counts(failures.motion_bearing)}. Speed quartiles "
-            f"{failures.speed_quartiles} m/s, step quartiles {failures.step_quartiles}.")
+    return (
+        f"{failures.invalid} episodes. Failed terms: {_counts(failures.terms)}. Terrain in the trunk cylinder: "
+        f"{_counts(failures.trunk_bearing)}. Motion: {_counts(failures.motion_bearing)}. Speed quartiles "
+        f"{failures.speed_quartiles} m/s, step quartiles {failures.step_quartiles}."
+    )
 
 
 def failures_figure(terrain, field, episodes, path: Path, seed: int, config) -> None:
@@ -144,12 +169,25 @@ def failures_figure(terrain, field, episodes, path: Path, seed: int, config) -> 
         terms = reachability_terms(field, failed, config)
         for name, color in TERM_COLORS.items():
             chosen = failed[~terms[name]]
-            axes.plot(chosen[:, 0], chosen[:, 1], "o", color=color, markersize=4, label=f"{name} fails",
-                      markeredgecolor="black", markeredgewidth=0.4)
+            axes.plot(
+                chosen[:, 0],
+                chosen[:, 1],
+                "o",
+                color=color,
+                markersize=4,
+                label=f"{name} fails",
+                markeredgecolor="black",
+                markeredgewidth=0.4,
+            )
             for x, y, _, yaw in chosen:
-                axes.plot([x, x + 0.35 * np.cos(yaw)], [y, y + 0.35 * np.sin(yaw)], "-", color=color, linewidth=0.8)
+                axes.plot(
+                    [x, x + 0.35 * np.cos(yaw)], [y, y + 0.35 * np.sin(yaw)], "-", color=color, linewidth=0.8
+                )
         axes.legend(loc="upper right", fontsize=8)
-    axes.set_title(f"{terrain.name}: first invalid pose of the {len(failed)} of {len(episodes.failure_poses)} "
-                   f"episodes that end invalid (seed {seed}; tick: heading)", fontsize=9)
+    axes.set_title(
+        f"{terrain.name}: first invalid pose of the {len(failed)} of {len(episodes.failure_poses)} "
+        f"episodes that end invalid (seed {seed}; tick: heading)",
+        fontsize=9,
+    )
     figure.savefig(path, dpi=90)
     plt.close(figure)

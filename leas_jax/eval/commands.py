@@ -16,8 +16,11 @@ def _positive_int(name: str, allow_zero: bool = False):
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name} expects an integer, got {text!r}") from None
         if value < 0 or (value == 0 and not allow_zero):
-            raise argparse.ArgumentTypeError(f"{name} expects an integer >= {0 if allow_zero else 1}, got {text!r}")
+            raise argparse.ArgumentTypeError(
+                f"{name} expects an integer >= {0 if allow_zero else 1}, got {text!r}"
+            )
         return value
+
     return parse
 
 
@@ -36,22 +39,37 @@ def cmd_evaluate(args) -> int:
         scenarios = [s.strip() for s in args.scenario.split(",") if s.strip()]
         unknown = [s for s in scenarios if s not in SCENARIOS + ("all",)]
         if unknown or not scenarios:
-            raise UsageError(f"--scenario: unknown scenario {', '.join(unknown) or repr(args.scenario)} "
-                             f"(expected {'|'.join(SCENARIOS)}|all)")
+            raise UsageError(
+                f"--scenario: unknown scenario {', '.join(unknown) or repr(args.scenario)} "
+                f"(expected {'|'.join(SCENARIOS)}|all)"
+            )
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} exists and is not a directory")
-    report = evaluate(scenarios, parse_methods(args.methods), args.checkpoint, out, args.n_starts, args.workers,
-                      terrain_file=args.terrain, progress=not args.no_progress, address=args.ray_address,
-                      leas_stop_at_invalid=args.leas_stop_at_invalid)
+    report = evaluate(
+        scenarios,
+        parse_methods(args.methods),
+        args.checkpoint,
+        out,
+        args.n_starts,
+        args.workers,
+        terrain_file=args.terrain,
+        progress=not args.no_progress,
+        address=args.ray_address,
+        leas_stop_at_invalid=args.leas_stop_at_invalid,
+    )
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))
     for row in report["rows"]:
         if row["cell"] == "all" or len(report["scenarios"][row["scenario"]]["cells"]) == 1:
-            print(f"{row['scenario']:12s} {row['method']:11s} n={row['n']:3d} coverage {row['coverage']:5.1f}% "
-                  f"success {row['success']:5.1f}%")
-    print(f"{report['seconds']:.1f} s -> {out}/results.json, table.md, table.csv, guides.npz, "
-          + ", ".join(report.get("figures", [])))
+            print(
+                f"{row['scenario']:12s} {row['method']:11s} n={row['n']:3d} coverage {row['coverage']:5.1f}% "
+                f"success {row['success']:5.1f}%"
+            )
+    print(
+        f"{report['seconds']:.1f} s -> {out}/results.json, table.md, table.csv, guides.npz, "
+        + ", ".join(report.get("figures", []))
+    )
     return 0
 
 
@@ -62,8 +80,15 @@ def cmd_hole_sweep(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} exists and is not a directory")
-    report = hole_width_sweep(parse_widths(args.widths), parse_methods(args.methods) or DEFAULT_METHODS,
-                              args.checkpoint, args.n_starts, args.workers, out, progress=not args.no_progress)
+    report = hole_width_sweep(
+        parse_widths(args.widths),
+        parse_methods(args.methods) or DEFAULT_METHODS,
+        args.checkpoint,
+        args.n_starts,
+        args.workers,
+        out,
+        progress=not args.no_progress,
+    )
     print(markdown(report), end="")
     print(f"{report['seconds']:.1f} s -> {out}/hole_sweep.json, hole_sweep.md, hole_sweep.png")
     return 0
@@ -77,7 +102,9 @@ def cmd_arena_check(args) -> int:
         raise UsageError(f"--out {args.out!r} exists and is not a directory")
     if args.terrain is not None and not Path(args.terrain).is_file():
         raise UsageError(f"--terrain: no such file {args.terrain!r}")
-    report = arena_check(args.checkpoint, args.episodes, parse_seeds(args.seeds), terrain_file=args.terrain, out=out)
+    report = arena_check(
+        args.checkpoint, args.episodes, parse_seeds(args.seeds), terrain_file=args.terrain, out=out
+    )
     print(markdown(report), end="")
     print(f"{report['seconds']:.1f} s -> {out}/arena_check.json, arena_check.md, arena_failures.png")
     return 0
@@ -86,13 +113,28 @@ def cmd_arena_check(args) -> int:
 def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_more: str = "") -> None:
     """--methods, --checkpoint, --n-starts, --workers, --no-progress and --out of the commands that run
     scenarios."""
-    parser.add_argument("--methods", metavar="LIST", help=f"comma-separated subset of {','.join(METHODS)} "
-                                                          f"(default: {methods_default})")
-    parser.add_argument("--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)")
-    parser.add_argument("--n-starts", type=_positive_int("--n-starts"), default=None, metavar="N",
-                        help=f"starts per {starts_per} (default: the scenario table's n_starts, 60)")
-    parser.add_argument("--workers", type=_positive_int("--workers", allow_zero=True), default=None, metavar="N",
-                        help=f"contact-generator and RRT processes (default one per CPU; 0: in-process){workers_more}")
+    parser.add_argument(
+        "--methods",
+        metavar="LIST",
+        help=f"comma-separated subset of {','.join(METHODS)} (default: {methods_default})",
+    )
+    parser.add_argument(
+        "--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)"
+    )
+    parser.add_argument(
+        "--n-starts",
+        type=_positive_int("--n-starts"),
+        default=None,
+        metavar="N",
+        help=f"starts per {starts_per} (default: the scenario table's n_starts, 60)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=_positive_int("--workers", allow_zero=True),
+        default=None,
+        metavar="N",
+        help=f"contact-generator and RRT processes (default one per CPU; 0: in-process){workers_more}",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
 
@@ -101,46 +143,73 @@ def register(subparsers) -> None:
     from leas_jax.cli import add_ray_address_argument
 
     parser = subparsers.add_parser(
-        "evaluate", help="baselines and LeaS on the paper's scenarios (Table II, Figs. 6-9)",
+        "evaluate",
+        help="baselines and LeaS on the paper's scenarios (Table II, Figs. 6-9)",
         description="Draw seeded starts from each scenario's [scenario] table, build guide paths with each steering "
-                    "method, validate them with the contact generator in parallel and write results.json, table.md, "
-                    "table.csv, guides.npz and one PNG per scenario. `ground` runs Table II (3 yaw ranges x 3 "
-                    "initial speeds).")
-    parser.add_argument("--scenario", metavar="NAME", help=f"{'|'.join(SCENARIOS)}|all, or a comma-separated list")
-    parser.add_argument("--terrain", metavar="FILE", help="any terrain file with a [scenario] table (instead of "
-                                                          "--scenario)")
-    _add_run_arguments(parser, "the paper's methods for each scenario", "cell",
-                       ", or Ray actors with --ray-address (default: the cluster's CPUs)")
+        "method, validate them with the contact generator in parallel and write results.json, table.md, "
+        "table.csv, guides.npz and one PNG per scenario. `ground` runs Table II (3 yaw ranges x 3 "
+        "initial speeds).",
+    )
+    parser.add_argument(
+        "--scenario", metavar="NAME", help=f"{'|'.join(SCENARIOS)}|all, or a comma-separated list"
+    )
+    parser.add_argument(
+        "--terrain", metavar="FILE", help="any terrain file with a [scenario] table (instead of --scenario)"
+    )
+    _add_run_arguments(
+        parser,
+        "the paper's methods for each scenario",
+        "cell",
+        ", or Ray actors with --ray-address (default: the cluster's CPUs)",
+    )
     add_ray_address_argument(parser, "run the contact generator")
-    parser.add_argument("--leas-stop-at-invalid", action="store_true",
-                        help="end LeaS paths before the first pose the reachability condition rejects, as training "
-                             "episodes end (default: the policy rolls on and the contact generator alone judges its "
-                             "paths, as it judges the baselines' paths)")
+    parser.add_argument(
+        "--leas-stop-at-invalid",
+        action="store_true",
+        help="end LeaS paths before the first pose the reachability condition rejects, as training "
+        "episodes end (default: the policy rolls on and the contact generator alone judges its "
+        "paths, as it judges the baselines' paths)",
+    )
     parser.set_defaults(func=cmd_evaluate)
 
     from leas_jax.eval.sweeps import DEFAULT_METHODS, DEFAULT_WIDTHS
 
     sweep = subparsers.add_parser(
-        "hole-sweep", help="the hole scenario with holes of several widths (how wide a hole LeaS walks round)",
+        "hole-sweep",
+        help="the hole scenario with holes of several widths (how wide a hole LeaS walks round)",
         description="Run eval_hole's scenario on copies of its terrain whose hole has each given width across the "
-                    "line to the target, and write hole_sweep.json, hole_sweep.md, hole_sweep.png (success against "
-                    "width) and one scenario figure per width.")
-    sweep.add_argument("--widths", default=",".join(f"{w:g}" for w in DEFAULT_WIDTHS), metavar="LIST",
-                       help="comma-separated hole widths in m, each in (0, 7] (default: %(default)s)")
+        "line to the target, and write hole_sweep.json, hole_sweep.md, hole_sweep.png (success against "
+        "width) and one scenario figure per width.",
+    )
+    sweep.add_argument(
+        "--widths",
+        default=",".join(f"{w:g}" for w in DEFAULT_WIDTHS),
+        metavar="LIST",
+        help="comma-separated hole widths in m, each in (0, 7] (default: %(default)s)",
+    )
     _add_run_arguments(sweep, ",".join(DEFAULT_METHODS), "width")
     sweep.set_defaults(func=cmd_hole_sweep)
 
     check = subparsers.add_parser(
-        "arena-check", help="speed on eval_ground, safety on the training arena, and why episodes end invalid",
+        "arena-check",
+        help="speed on eval_ground, safety on the training arena, and why episodes end invalid",
         description="The foundation's acceptance figures of a policy (deterministic): mean speed along the target "
-                    "direction on eval_ground, the fraction of random arena episodes without an invalid pose per "
-                    "evaluation seed, and for the others the failed reachability term, where the offending terrain "
-                    "lies around the root and the speed at the failure. Writes arena_check.json, arena_check.md and "
-                    "arena_failures.png.")
+        "direction on eval_ground, the fraction of random arena episodes without an invalid pose per "
+        "evaluation seed, and for the others the failed reachability term, where the offending terrain "
+        "lies around the root and the speed at the failure. Writes arena_check.json, arena_check.md and "
+        "arena_failures.png.",
+    )
     check.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
-    check.add_argument("--episodes", type=_positive_int("--episodes"), default=2048, metavar="N",
-                       help="arena episodes per seed (default: %(default)s)")
-    check.add_argument("--seeds", default="0,1", metavar="LIST", help="evaluation seeds (default: %(default)s)")
+    check.add_argument(
+        "--episodes",
+        type=_positive_int("--episodes"),
+        default=2048,
+        metavar="N",
+        help="arena episodes per seed (default: %(default)s)",
+    )
+    check.add_argument(
+        "--seeds", default="0,1", metavar="LIST", help="evaluation seeds (default: %(default)s)"
+    )
     check.add_argument("--terrain", metavar="FILE", help="the arena (default: the policy's training terrain)")
     check.add_argument("--out", required=True, metavar="DIR", help="output directory")
     check.set_defaults(func=cmd_arena_check)

@@ -23,15 +23,28 @@ from __future__ import annotations
 import concurrent.futures
 import dataclasses
 import time
-from dataclasses import dataclass, field as dataclass_field
+from dataclasses import dataclass
+from dataclasses import field as dataclass_field
 from pathlib import Path
 
 import numpy as np
 
 from leas_jax.errors import UsageError
 from leas_jax.eval import metrics
-from leas_jax.eval.scenarios import (DEFAULT_METHODS, LEAS_METHODS, METHODS, RRT_METHODS, SCENARIOS, Cell, Starts,
-                                     cells_for, draw_starts, leas_horizon, route, scenario_file)
+from leas_jax.eval.scenarios import (
+    DEFAULT_METHODS,
+    LEAS_METHODS,
+    METHODS,
+    RRT_METHODS,
+    SCENARIOS,
+    Cell,
+    Starts,
+    cells_for,
+    draw_starts,
+    leas_horizon,
+    route,
+    scenario_file,
+)
 
 
 @dataclass
@@ -77,8 +90,9 @@ class ScenarioResult:
         for method in self.methods:
             rows = {}
             for k, cell in enumerate(self.cells):
-                rows[cell.name] = metrics.summarize(t.outcome for t in self.trajectories
-                                                    if t.method == method and t.cell == k)
+                rows[cell.name] = metrics.summarize(
+                    t.outcome for t in self.trajectories if t.method == method and t.cell == k
+                )
             rows["all"] = metrics.summarize(t.outcome for t in self.trajectories if t.method == method)
             table[method] = rows
         return table
@@ -91,8 +105,10 @@ def parse_methods(text: str | None) -> tuple[str, ...] | None:
     names = tuple(dict.fromkeys(m.strip() for m in text.split(",") if m.strip()))
     unknown = [m for m in names if m not in METHODS]
     if not names or unknown:
-        raise UsageError(f"--methods: unknown method(s) {', '.join(unknown) or repr(text)} "
-                         f"(expected a comma-separated subset of {','.join(METHODS)})")
+        raise UsageError(
+            f"--methods: unknown method(s) {', '.join(unknown) or repr(text)} "
+            f"(expected a comma-separated subset of {','.join(METHODS)})"
+        )
     return names
 
 
@@ -127,8 +143,9 @@ def _rrt_worker_plan(job):
     return plan_rrt(_RRT_FIELD, pose, target, speed, bounds, config, rrt, reach)
 
 
-def _rrt_plans(field, terrain, env, starts: Starts, target, config, rrt_config, workers: int,
-               progress: bool) -> list:
+def _rrt_plans(
+    field, terrain, env, starts: Starts, target, config, rrt_config, workers: int, progress: bool
+) -> list:
     """One RRT search per start (seed: rrt_config.seed + start index), in `workers` processes (0: here).
 
     Each search is seeded and bounded by iterations (its wall-time bound is a safety net far
@@ -138,34 +155,67 @@ def _rrt_plans(field, terrain, env, starts: Starts, target, config, rrt_config, 
 
     from leas_jax.steering.rrt import plan_rrt
 
-    jobs = [(pose, target, float(speed), terrain.bounds, config,
-             dataclasses.replace(rrt_config, seed=rrt_config.seed + k), env.reachability)
-            for k, (pose, speed) in enumerate(zip(starts.poses, starts.speeds))]
+    jobs = [
+        (
+            pose,
+            target,
+            float(speed),
+            terrain.bounds,
+            config,
+            dataclasses.replace(rrt_config, seed=rrt_config.seed + k),
+            env.reachability,
+        )
+        for k, (pose, speed) in enumerate(zip(starts.poses, starts.speeds))
+    ]
     bar = dict(total=len(jobs), desc="RBKino+RRT", disable=not progress, leave=False)
     if workers <= 0 or len(jobs) == 1:
         return [plan_rrt(field, *job) for job in tqdm(jobs, **bar)]
     import multiprocessing
 
-    with concurrent.futures.ProcessPoolExecutor(min(workers, len(jobs)), multiprocessing.get_context("spawn"),
-                                                initializer=_rrt_worker_start, initargs=(terrain, env)) as pool:
+    with concurrent.futures.ProcessPoolExecutor(
+        min(workers, len(jobs)),
+        multiprocessing.get_context("spawn"),
+        initializer=_rrt_worker_start,
+        initargs=(terrain, env),
+    ) as pool:
         return list(tqdm(pool.map(_rrt_worker_plan, jobs), **bar))
 
 
-def _leas_guides(policy, field, starts: Starts, routes: list[np.ndarray], max_steps: int,
-                 stop_at_invalid: bool) -> list:
+def _leas_guides(
+    policy, field, starts: Starts, routes: list[np.ndarray], max_steps: int, stop_at_invalid: bool
+) -> list:
     from leas_jax.steering.leas import rollout_batch
 
     width = max(len(r) for r in routes)
     # Pad every route to the same length by repeating its last point (rollout_batch's convention).
     padded = np.stack([np.concatenate([r, np.repeat(r[-1:], width - len(r), axis=0)]) for r in routes])
-    result = rollout_batch(policy, field, starts.poses, padded, starts.speeds, max_steps=max_steps,
-                           stop_at_invalid=stop_at_invalid)
+    result = rollout_batch(
+        policy,
+        field,
+        starts.poses,
+        padded,
+        starts.speeds,
+        max_steps=max_steps,
+        stop_at_invalid=stop_at_invalid,
+    )
     return [result.guide(n).astype(np.float64) for n in range(len(starts.poses))]
 
 
-def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, policy, n_starts: int,
-                       config, rrt_config, progress: bool = True, env=None,
-                       rrt_workers: int = 0, leas_stop_at_invalid: bool = False) -> tuple[list[Trajectory], dict]:
+def build_trajectories(
+    name: str,
+    terrain,
+    field,
+    cells: list[Cell],
+    methods,
+    policy,
+    n_starts: int,
+    config,
+    rrt_config,
+    progress: bool = True,
+    env=None,
+    rrt_workers: int = 0,
+    leas_stop_at_invalid: bool = False,
+) -> tuple[list[Trajectory], dict]:
     """Starts and guides of every cell and method of one scenario (no validation yet).
 
     `env` (default: the policy's, else EnvConfig()) is what `field` was built with;
@@ -184,22 +234,33 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
     target = np.asarray(scenario.target, np.float64)
     trajectories, seconds = [], {m: 0.0 for m in methods}
     for k, cell in enumerate(cells):
-        starts = draw_starts(scenario, cell, n_starts, scenario.seed + k, field, config.nominal_root_height,
-                             env.reachability)
+        starts = draw_starts(
+            scenario, cell, n_starts, scenario.seed + k, field, config.nominal_root_height, env.reachability
+        )
 
-        def add(method, guides, waypoints=None, errors=None):
+        def add(method, guides, waypoints=None, errors=None, k=k, starts=starts):
             for n in range(len(starts.poses)):
-                trajectories.append(Trajectory(
-                    cell=k, method=method, start=starts.poses[n], speed=float(starts.speeds[n]),
-                    yaw_offset_deg=float(starts.yaw_offsets_deg[n]), guide=guides[n],
-                    waypoints=None if waypoints is None else waypoints[n],
-                    error=None if errors is None else errors[n]))
+                trajectories.append(
+                    Trajectory(
+                        cell=k,
+                        method=method,
+                        start=starts.poses[n],
+                        speed=float(starts.speeds[n]),
+                        yaw_offset_deg=float(starts.yaw_offsets_deg[n]),
+                        guide=guides[n],
+                        waypoints=None if waypoints is None else waypoints[n],
+                        error=None if errors is None else errors[n],
+                    )
+                )
 
         for method in ("rblin", "rbkino"):
             if method in methods:
                 began = time.perf_counter()
-                add(method, _baseline_guides(method, field, starts, points, config),
-                    [points] * n_starts if len(points) > 1 else None)
+                add(
+                    method,
+                    _baseline_guides(method, field, starts, points, config),
+                    [points] * n_starts if len(points) > 1 else None,
+                )
                 seconds[method] += time.perf_counter() - began
         plans = None
         if any(m in methods for m in RRT_METHODS):
@@ -207,16 +268,24 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
             plans = _rrt_plans(field, terrain, env, starts, target, config, rrt_config, rrt_workers, progress)
             seconds["rrt_search"] = seconds.get("rrt_search", 0.0) + time.perf_counter() - began
         if "rbkino_rrt" in methods:
-            add("rbkino_rrt", [p.guide if p.success else None for p in plans],
+            add(
+                "rbkino_rrt",
+                [p.guide if p.success else None for p in plans],
                 [p.waypoints if p.success else None for p in plans],
-                [None if p.success else "rrt: no path" for p in plans])
+                [None if p.success else "rrt: no path" for p in plans],
+            )
         horizon = policy.config.env.episode_length if policy is not None else 400
         if "leas" in methods:
             began = time.perf_counter()
-            steps = max(leas_horizon(p[:2], points, config.target_speed, config.timestep, horizon)
-                        for p in starts.poses)
-            add("leas", _leas_guides(policy, field, starts, [points] * n_starts, steps, leas_stop_at_invalid),
-                [points] * n_starts if len(points) > 1 else None)
+            steps = max(
+                leas_horizon(p[:2], points, config.target_speed, config.timestep, horizon)
+                for p in starts.poses
+            )
+            add(
+                "leas",
+                _leas_guides(policy, field, starts, [points] * n_starts, steps, leas_stop_at_invalid),
+                [points] * n_starts if len(points) > 1 else None,
+            )
             seconds["leas"] += time.perf_counter() - began
         if "leas_rrt" in methods:
             began = time.perf_counter()
@@ -225,27 +294,44 @@ def build_trajectories(name: str, terrain, field, cells: list[Cell], methods, po
             if ok:
                 sub = Starts(starts.poses[ok], starts.speeds[ok], starts.yaw_offsets_deg[ok])
                 routes = [plans[n].waypoints for n in ok]
-                steps = max(leas_horizon(starts.poses[n, :2], plans[n].waypoints, config.target_speed,
-                                         config.timestep, horizon) for n in ok)
-                for n, guide in zip(ok, _leas_guides(policy, field, sub, routes, steps, leas_stop_at_invalid)):
+                steps = max(
+                    leas_horizon(
+                        starts.poses[n, :2], plans[n].waypoints, config.target_speed, config.timestep, horizon
+                    )
+                    for n in ok
+                )
+                for n, guide in zip(
+                    ok, _leas_guides(policy, field, sub, routes, steps, leas_stop_at_invalid)
+                ):
                     guides[n] = guide
-            add("leas_rrt", guides, [p.waypoints if p.success else None for p in plans],
-                [None if p.success else "rrt: no path" for p in plans])
+            add(
+                "leas_rrt",
+                guides,
+                [p.waypoints if p.success else None for p in plans],
+                [None if p.success else "rrt: no path" for p in plans],
+            )
             seconds["leas_rrt"] += time.perf_counter() - began
     order = {m: i for i, m in enumerate(methods)}
     trajectories.sort(key=lambda t: (t.cell, order[t.method]))
     return trajectories, seconds
 
 
-def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: int, progress: bool = True,
-             desc: str = "contact planning", address: str | None = None) -> None:
+def validate(
+    terrain,
+    trajectories: list[Trajectory],
+    timestep: float,
+    workers: int,
+    progress: bool = True,
+    desc: str = "contact planning",
+    address: str | None = None,
+) -> None:
     """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`. Host-only.
 
     `address`: a Ray cluster for the pool (`ValidationPool(address=...)`); None for local processes.
     """
     from tqdm.auto import tqdm
 
-    from leas_jax.contacts.pool import ValidationPool
+    from leas_jax.contacts.validation.pool import ValidationPool
 
     target = np.asarray(terrain.scenario.target, np.float64)
     todo = [t for t in trajectories if t.guide is not None and t.error is None]
@@ -260,8 +346,14 @@ def validate(terrain, trajectories: list[Trajectory], timestep: float, workers: 
             for future in concurrent.futures.as_completed(futures):
                 t = futures[future]
                 (result,) = future.result()
-                t.outcome = metrics.outcome(t.guide, target, result.coverage, result.last_valid_index,
-                                            plan=result.plan, error=result.error)
+                t.outcome = metrics.outcome(
+                    t.guide,
+                    target,
+                    result.coverage,
+                    result.last_valid_index,
+                    plan=result.plan,
+                    error=result.error,
+                )
                 bar.update(1)
 
 
@@ -280,14 +372,24 @@ def policy_for(methods, checkpoint):
 def default_workers() -> int:
     """Processes for the contact generator and the RRT searches: one per CPU this process may use
     (the main process only waits while they work)."""
-    from leas_jax.contacts.pool import available_cpus
+    from leas_jax.contacts.validation.pool import available_cpus
 
     return available_cpus()
 
 
-def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, workers: int, config=None,
-                 rrt_config=None, progress: bool = True, address: str | None = None,
-                 leas_stop_at_invalid: bool = False) -> ScenarioResult:
+def run_scenario(
+    name: str,
+    terrain,
+    methods,
+    policy,
+    n_starts: int | None,
+    workers: int,
+    config=None,
+    rrt_config=None,
+    progress: bool = True,
+    address: str | None = None,
+    leas_stop_at_invalid: bool = False,
+) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
     Args:
@@ -317,18 +419,48 @@ def run_scenario(name: str, terrain, methods, policy, n_starts: int | None, work
     n = int(n_starts or terrain.scenario.n_starts)
     result = ScenarioResult(name, terrain, cells, tuple(methods))
     result.trajectories, result.seconds = build_trajectories(
-        name, terrain, field, cells, methods, policy, n, config, rrt_config or RRTConfig(), progress, env,
-        rrt_workers=workers or 0, leas_stop_at_invalid=leas_stop_at_invalid)
+        name,
+        terrain,
+        field,
+        cells,
+        methods,
+        policy,
+        n,
+        config,
+        rrt_config or RRTConfig(),
+        progress,
+        env,
+        rrt_workers=workers or 0,
+        leas_stop_at_invalid=leas_stop_at_invalid,
+    )
     began = time.perf_counter()
-    validate(terrain, result.trajectories, config.timestep, workers, progress, desc=f"{name}: contact planning",
-             address=address)
+    validate(
+        terrain,
+        result.trajectories,
+        config.timestep,
+        workers,
+        progress,
+        desc=f"{name}: contact planning",
+        address=address,
+    )
     result.seconds["contact_planning"] = time.perf_counter() - began
     return result
 
 
-def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int | None = None,
-             workers: int | None = None, terrain_file=None, progress: bool = True, rrt_config=None,
-             figures: bool = True, address: str | None = None, leas_stop_at_invalid: bool = False) -> dict:
+def evaluate(
+    scenarios,
+    methods=None,
+    checkpoint=None,
+    out=None,
+    n_starts: int | None = None,
+    workers: int | None = None,
+    terrain_file=None,
+    progress: bool = True,
+    rrt_config=None,
+    figures: bool = True,
+    address: str | None = None,
+    leas_stop_at_invalid: bool = False,
+) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
     Args:
@@ -344,7 +476,7 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
         rrt_config: `RRTConfig`.
         figures: write PNG figures.
         address: contact generator on a Ray cluster ("ray://HOST:PORT", "auto",
-            "local"; see `leas_jax.contacts.ray_backend`); None: local processes.
+            "local"; see `leas_jax.contacts.validation.ray_backend`); None: local processes.
         leas_stop_at_invalid: end LeaS paths before the first pose the reachability
             condition rejects, as training episodes end. By default (False) the policy
             rolls on through such poses and the contact generator alone judges its
@@ -366,13 +498,15 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
     if terrain_file is not None:
         terrain = load_terrain(terrain_file)
         if terrain.scenario is None:
-            raise UsageError(f"--terrain {terrain_file}: no [scenario] table (DESIGN §4)")
+            raise UsageError(f"--terrain {terrain_file}: no [scenario] table (docs/design.md §4)")
         jobs = [(terrain.name, terrain)]
     else:
         names = list(SCENARIOS) if "all" in scenarios else list(dict.fromkeys(scenarios))
         jobs = [(name, load_terrain(scenario_file(name))) for name in names]
-    wanted = {name: tuple(methods) if methods else DEFAULT_METHODS.get(name, ("rblin", "rbkino", "leas"))
-              for name, _ in jobs}
+    wanted = {
+        name: tuple(methods) if methods else DEFAULT_METHODS.get(name, ("rblin", "rbkino", "leas"))
+        for name, _ in jobs
+    }
     if n_starts is not None and n_starts < 1:
         raise UsageError(f"--n-starts: expected a positive integer, got {n_starts}")
     policy = policy_for({m for ms in wanted.values() for m in ms}, checkpoint)
@@ -382,11 +516,23 @@ def evaluate(scenarios, methods=None, checkpoint=None, out=None, n_starts: int |
         raise UsageError(f"--workers: expected an integer >= 0, got {workers}")
     results = []
     for name, terrain in jobs:
-        results.append(run_scenario(name, terrain, wanted[name], policy, n_starts, workers,
-                                    rrt_config=rrt_config, progress=progress, address=address,
-                                    leas_stop_at_invalid=leas_stop_at_invalid))
-    report = tables.results_dict(results, policy=policy, seconds=time.perf_counter() - began,
-                                 leas_stop_at_invalid=leas_stop_at_invalid)
+        results.append(
+            run_scenario(
+                name,
+                terrain,
+                wanted[name],
+                policy,
+                n_starts,
+                workers,
+                rrt_config=rrt_config,
+                progress=progress,
+                address=address,
+                leas_stop_at_invalid=leas_stop_at_invalid,
+            )
+        )
+    report = tables.results_dict(
+        results, policy=policy, seconds=time.perf_counter() - began, leas_stop_at_invalid=leas_stop_at_invalid
+    )
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
@@ -427,6 +573,13 @@ def checkpoint_policies(run_dir, limit: int | None = None) -> list:
     policies = []
     for steps, path in found:
         state = load_state(path)
-        policies.append(Policy(config=config, normalizer=state.normalizer, params=state.params.policy,
-                               env_steps=int(steps), source=str(path)))
+        policies.append(
+            Policy(
+                config=config,
+                normalizer=state.normalizer,
+                params=state.params.policy,
+                env_steps=int(steps),
+                source=str(path),
+            )
+        )
     return policies

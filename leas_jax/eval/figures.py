@@ -29,8 +29,15 @@ def draw_heightmap(axes, terrain) -> None:
     half = terrain.resolution / 2
     shown = np.ma.masked_where(heights <= terrain.void_height, heights)
     cmap = plt.get_cmap("Greys").with_extremes(bad="#303030")
-    axes.imshow(shown.T, origin="lower", extent=(xmin - half, xmax + half, ymin - half, ymax + half),
-                cmap=cmap, vmin=float(shown.min()) - 0.3, vmax=float(shown.max()) + 1.0, interpolation="nearest")
+    axes.imshow(
+        shown.T,
+        origin="lower",
+        extent=(xmin - half, xmax + half, ymin - half, ymax + half),
+        cmap=cmap,
+        vmin=float(shown.min()) - 0.3,
+        vmax=float(shown.max()) + 1.0,
+        interpolation="nearest",
+    )
     axes.set_xlim(xmin, xmax)
     axes.set_ylim(ymin, ymax)
     axes.set_aspect("equal")
@@ -44,7 +51,7 @@ def draw_trajectories(axes, terrain, trajectories, title: str = "") -> None:
         o = t.outcome
         if t.guide is not None:
             last = len(t.guide) - 1 if o is None else max(o.last_valid_index, 0)
-            axes.plot(t.guide[:last + 1, 0], t.guide[:last + 1, 1], "-", color=SUCCESS_COLOR, linewidth=0.8)
+            axes.plot(t.guide[: last + 1, 0], t.guide[: last + 1, 1], "-", color=SUCCESS_COLOR, linewidth=0.8)
             if last < len(t.guide) - 1:
                 axes.plot(t.guide[last:, 0], t.guide[last:, 1], "-", color=FAILED_PART_COLOR, linewidth=0.8)
         if t.waypoints is not None and t.method in ("rbkino_rrt", "leas_rrt"):
@@ -52,8 +59,15 @@ def draw_trajectories(axes, terrain, trajectories, title: str = "") -> None:
             axes.plot(w[:, 0], w[:, 1], ".", color="black", markersize=3)
         color = SUCCESS_COLOR if (o is not None and o.success) else FAILURE_COLOR
         axes.plot(t.start[0], t.start[1], "o", color=color, markeredgecolor="black", markersize=4, zorder=5)
-        axes.arrow(t.start[0], t.start[1], 0.25 * np.cos(t.start[3]), 0.25 * np.sin(t.start[3]), width=0.015,
-                   color="black", zorder=6)
+        axes.arrow(
+            t.start[0],
+            t.start[1],
+            0.25 * np.cos(t.start[3]),
+            0.25 * np.sin(t.start[3]),
+            width=0.015,
+            color="black",
+            zorder=6,
+        )
     if scenario is not None:
         if scenario.waypoints is not None:
             w = np.asarray(scenario.waypoints)
@@ -78,19 +92,29 @@ def scenario_figure(result):
     (xmin, ymin), (xmax, ymax) = result.terrain.bounds
     width = 4.2
     height = width * (ymax - ymin) / (xmax - xmin) + 0.5
-    figure, axes = plt.subplots(len(groups), len(methods), figsize=(width * len(methods), height * len(groups)),
-                                squeeze=False, layout="constrained")
+    figure, axes = plt.subplots(
+        len(groups),
+        len(methods),
+        figsize=(width * len(methods), height * len(groups)),
+        squeeze=False,
+        layout="constrained",
+    )
     for row, (yaw, members) in enumerate(groups.items()):
         for col, method in enumerate(methods):
             chosen = [t for t in result.trajectories if t.method == method and t.cell in members]
             n = len(chosen)
             coverage = 100 * np.mean([t.outcome.coverage for t in chosen]) if n else float("nan")
             success = sum(t.outcome.success for t in chosen)
-            title = (f"{METHOD_LABELS.get(method, method)}, yaw {yaw[0]:g}..{yaw[1]:g} deg\n"
-                     f"coverage {coverage:.1f}%, success {success}/{n}")
+            title = (
+                f"{METHOD_LABELS.get(method, method)}, yaw {yaw[0]:g}..{yaw[1]:g} deg\n"
+                f"coverage {coverage:.1f}%, success {success}/{n}"
+            )
             draw_trajectories(axes[row][col], result.terrain, chosen, title)
-    figure.suptitle(f"{result.name}: blue dot success, yellow dot failure; blue path covered by the contact plan, "
-                    "red failed part", fontsize=9)
+    figure.suptitle(
+        f"{result.name}: blue dot success, yellow dot failure; blue path covered by the contact plan, "
+        "red failed part",
+        fontsize=9,
+    )
     return figure
 
 

@@ -31,8 +31,9 @@ class GroundSpeed:
     guides: list
 
 
-def ground_speed(policy, terrain, field: Heightfield, n: int = 256, seed: int = 0,
-                 steps: int = 400) -> GroundSpeed:
+def ground_speed(
+    policy, terrain, field: Heightfield, n: int = 256, seed: int = 0, steps: int = 400
+) -> GroundSpeed:
     """Mean speed along the target direction over `steps` steps from random headings.
 
     Starts are drawn in the terrain's scenario start region with a uniform
@@ -55,8 +56,12 @@ def ground_speed(policy, terrain, field: Heightfield, n: int = 256, seed: int = 
     result = rollout_batch(policy, field, starts, targets, max_steps=steps, stop_at_target=False)
     final = result.poses[np.arange(n), result.lengths - 1, :2]
     along = (final - xy) @ direction / (steps * result.timestep)
-    return GroundSpeed(mean_speed=float(along.mean()), invalid_fraction=float(result.invalid.mean()),
-                       per_episode=along, guides=[result.guide(k) for k in range(n)])
+    return GroundSpeed(
+        mean_speed=float(along.mean()),
+        invalid_fraction=float(result.invalid.mean()),
+        per_episode=along,
+        guides=[result.guide(k) for k in range(n)],
+    )
 
 
 @dataclass(frozen=True)
@@ -83,7 +88,9 @@ class ArenaEpisodes:
     failure_velocities: np.ndarray
 
 
-def arena_episodes(policy, field: Heightfield, n: int = 256, seed: int = 0, steps: int = 400) -> ArenaEpisodes:
+def arena_episodes(
+    policy, field: Heightfield, n: int = 256, seed: int = 0, steps: int = 400
+) -> ArenaEpisodes:
     """Run `n` episodes from the env's own random resets (random start, yaw, speed, target direction)."""
     config = dataclasses.replace(policy.config.env, episode_length=steps + 1)
 
@@ -98,8 +105,9 @@ def arena_episodes(policy, field: Heightfield, n: int = 256, seed: int = 0, step
                 state, alive, failure = carry
                 new = env.step(state, policy(state.obs))
                 ends = alive & (new.metrics["invalid"] > 0)
-                failure = jnp.where(ends, jnp.concatenate([new.pipeline_state.pose, new.pipeline_state.vel]),
-                                    failure)
+                failure = jnp.where(
+                    ends, jnp.concatenate([new.pipeline_state.pose, new.pipeline_state.vel]), failure
+                )
                 alive = alive & ~ends
                 state = jax.tree.map(lambda a, b: jnp.where(alive, a, b), new, state)
                 return (state, alive, failure), (state.pipeline_state.pose, alive)
@@ -113,13 +121,19 @@ def arena_episodes(policy, field: Heightfield, n: int = 256, seed: int = 0, step
         return jax.vmap(one)(keys)
 
     poses, lengths, alive, progress, failure = jax.device_get(
-        run(field, jax.random.split(jax.random.PRNGKey(seed), n)))
+        run(field, jax.random.split(jax.random.PRNGKey(seed), n))
+    )
     moved_late = np.linalg.norm(poses[:, -1, :2] - poses[:, -51, :2], axis=1)
     stopped = alive & (moved_late < 0.1)
-    return ArenaEpisodes(valid_fraction=float(alive.mean()),
-                         stopped_fraction=float(stopped.sum() / max(alive.sum(), 1)),
-                         mean_progress=float(progress.mean()), poses=np.asarray(poses), lengths=np.asarray(lengths),
-                         failure_poses=np.asarray(failure[:, :4]), failure_velocities=np.asarray(failure[:, 4:]))
+    return ArenaEpisodes(
+        valid_fraction=float(alive.mean()),
+        stopped_fraction=float(stopped.sum() / max(alive.sum(), 1)),
+        mean_progress=float(progress.mean()),
+        poses=np.asarray(poses),
+        lengths=np.asarray(lengths),
+        failure_poses=np.asarray(failure[:, :4]),
+        failure_velocities=np.asarray(failure[:, 4:]),
+    )
 
 
 # Sectors of a bearing in the root frame (degrees, 0 = heading, counter-clockwise = left).
@@ -206,9 +220,15 @@ def failure_breakdown(field: Heightfield, episodes: ArenaEpisodes, config) -> Fa
     speed = np.linalg.norm(velocity[:, :2], axis=1)
     steps = episodes.lengths[failed]
     return FailureBreakdown(
-        invalid=int(len(failed)), terms=counts(labels),
-        trunk_bearing={**counts(bearing_sector(np.degrees(np.arctan2(centroid[:, 1], centroid[:, 0])))),
-                       **({"unlocated": unlocated} if unlocated else {})},
-        motion_bearing=counts(bearing_sector(np.degrees(np.arctan2(local_velocity[:, 1], local_velocity[:, 0])))),
+        invalid=int(len(failed)),
+        terms=counts(labels),
+        trunk_bearing={
+            **counts(bearing_sector(np.degrees(np.arctan2(centroid[:, 1], centroid[:, 0])))),
+            **({"unlocated": unlocated} if unlocated else {}),
+        },
+        motion_bearing=counts(
+            bearing_sector(np.degrees(np.arctan2(local_velocity[:, 1], local_velocity[:, 0])))
+        ),
         speed_quartiles=[round(float(v), 4) for v in np.percentile(speed, [25, 50, 75])],
-        step_quartiles=[float(v) for v in np.percentile(steps, [25, 50, 75])])
+        step_quartiles=[float(v) for v in np.percentile(steps, [25, 50, 75])],
+    )

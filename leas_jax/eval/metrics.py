@@ -1,4 +1,4 @@
-"""Per-trajectory metrics of DESIGN §8 and their aggregates.
+"""Per-trajectory metrics of docs/design.md §8 and their aggregates.
 
 coverage: arc-length fraction of the guide covered by the contact plan (the
     generator's `coverage`; Table II's "success rate").
@@ -27,7 +27,7 @@ class Outcome:
 
     Attributes:
         coverage: in [0, 1].
-        success: DESIGN §8.
+        success: docs/design.md §8.
         last_valid_index: guide index of the last valid posture (-1: none).
         final_distance: m from the closest posture root (or guide pose) to the target.
         error: None, or why there is no plan ("rrt: no path", a planner error).
@@ -40,8 +40,15 @@ class Outcome:
     error: str | None = None
 
 
-def outcome(guide: np.ndarray | None, target, coverage: float, last_valid_index: int, plan=None,
-            error: str | None = None, radius: float = SUCCESS_RADIUS) -> Outcome:
+def outcome(
+    guide: np.ndarray | None,
+    target,
+    coverage: float,
+    last_valid_index: int,
+    plan=None,
+    error: str | None = None,
+    radius: float = SUCCESS_RADIUS,
+) -> Outcome:
     """Metrics of one guide from the contact generator's answer.
 
     Args:
@@ -57,13 +64,18 @@ def outcome(guide: np.ndarray | None, target, coverage: float, last_valid_index:
     """
     target = np.asarray(target, np.float64).reshape(2)
     if guide is None or error is not None:
-        return Outcome(float(coverage) if guide is not None else 0.0, False, int(last_valid_index),
-                       float("nan"), error or "no guide")
+        return Outcome(
+            float(coverage) if guide is not None else 0.0,
+            False,
+            int(last_valid_index),
+            float("nan"),
+            error or "no guide",
+        )
     guide = np.asarray(guide, np.float64).reshape(-1, 4)
     if plan is not None and len(plan.q):
         roots = np.asarray(plan.q, np.float64)[:, :2]
     elif last_valid_index >= 0:
-        roots = guide[last_valid_index:last_valid_index + 1, :2]
+        roots = guide[last_valid_index : last_valid_index + 1, :2]
     else:
         roots = np.zeros((0, 2))
     distance = float(np.min(np.hypot(*(roots - target).T))) if len(roots) else float("nan")
@@ -77,7 +89,9 @@ def summarize(outcomes) -> dict:
     n = len(outcomes)
     if n == 0:
         return {"n": 0, "coverage": float("nan"), "success": float("nan"), "errors": 0}
-    return {"n": n,
-            "coverage": 100.0 * float(np.mean([o.coverage for o in outcomes])),
-            "success": 100.0 * float(np.mean([o.success for o in outcomes])),
-            "errors": int(sum(o.error is not None for o in outcomes))}
+    return {
+        "n": n,
+        "coverage": 100.0 * float(np.mean([o.coverage for o in outcomes])),
+        "success": 100.0 * float(np.mean([o.success for o in outcomes])),
+        "errors": int(sum(o.error is not None for o in outcomes)),
+    }

@@ -1,7 +1,7 @@
 """Contact-planner coverage of LeaS policies over the same starts (host).
 
 Used to compare a geometric policy with its planner-in-the-loop fine-tuning
-(DESIGN §7): on the training arena (random starts and target directions from
+(docs/design.md §7): on the training arena (random starts and target directions from
 the env's own reset) and on evaluation scenarios (their `[scenario]` starts,
 through `leas_jax.eval.evaluate`).
 """
@@ -27,27 +27,41 @@ class Coverage:
         return f"{100 * self.mean_coverage:.1f} % | {100 * self.full_coverage_fraction:.1f} %"
 
 
-def arena_coverage(policy, terrain, field, n: int = 64, seed: int = 7, workers: int = 2,
-                   steps: int = 400) -> Coverage:
+def arena_coverage(
+    policy, terrain, field, n: int = 64, seed: int = 7, workers: int = 2, steps: int = 400
+) -> Coverage:
     """Roll the deterministic policy from `n` env resets (seeded) and plan contacts along each guide."""
-    from leas_jax.contacts.pool import validate_paths
+    from leas_jax.contacts.validation.pool import validate_paths
 
     episodes = arena_episodes(policy, field, n=n, seed=seed, steps=steps)
     guides = [episodes.poses[k, : episodes.lengths[k]].astype(np.float64) for k in range(n)]
     results = validate_paths(terrain, guides, policy.config.env.timestep, workers=workers, return_plans=False)
     coverage = np.array([r.coverage for r in results])
-    return Coverage(n=n, mean_coverage=float(coverage.mean()), full_coverage_fraction=float((coverage >= 1.0).mean()))
+    return Coverage(
+        n=n, mean_coverage=float(coverage.mean()), full_coverage_fraction=float((coverage >= 1.0).mean())
+    )
 
 
 def scenario_coverage(run_dir, scenarios, n_starts: int, workers: int) -> dict:
     """{scenario: Coverage} of the LeaS policy in `run_dir` on evaluation scenarios (same seeded starts)."""
     from leas_jax.eval.evaluate import evaluate
 
-    report = evaluate(list(scenarios), methods=["leas"], checkpoint=run_dir, out=None, n_starts=n_starts,
-                      workers=workers, progress=False, figures=False)
+    report = evaluate(
+        list(scenarios),
+        methods=["leas"],
+        checkpoint=run_dir,
+        out=None,
+        n_starts=n_starts,
+        workers=workers,
+        progress=False,
+        figures=False,
+    )
     out = {}
     for name, scenario in report["scenarios"].items():
         coverage = np.array([t["coverage"] for t in scenario["trajectories"] if t["method"] == "leas"])
-        out[name] = Coverage(n=len(coverage), mean_coverage=float(coverage.mean()),
-                                         full_coverage_fraction=float((coverage >= 1.0).mean()))
+        out[name] = Coverage(
+            n=len(coverage),
+            mean_coverage=float(coverage.mean()),
+            full_coverage_fraction=float((coverage >= 1.0).mean()),
+        )
     return out

@@ -21,8 +21,14 @@ def read_metrics(run_dir: Path) -> list[dict]:
     return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
 
 
-def plot_curves(records: list[dict], panels: list[tuple[str, str]], path: Path, steps_scale: float = 1e6,
-                steps_label: str = "env steps (M)", color: str = "tab:blue") -> None:
+def plot_curves(
+    records: list[dict],
+    panels: list[tuple[str, str]],
+    path: Path,
+    steps_scale: float = 1e6,
+    steps_label: str = "env steps (M)",
+    color: str = "tab:blue",
+) -> None:
     """PNG with one panel per (metric key, title) against env steps."""
     import matplotlib
 
@@ -40,10 +46,18 @@ def plot_curves(records: list[dict], panels: list[tuple[str, str]], path: Path, 
     plt.close(figure)
 
 
-GEOMETRIC_PANELS = [("episode_return", "episode return"), ("episode_length", "episode length (steps)"),
-                    ("invalid_fraction", "episodes ending invalid (fraction)"), ("sps", "env steps / s")]
-PLANNER_PANELS = [("mean_coverage", "mean contact-plan coverage"), ("full_coverage_fraction", "fully covered paths"),
-                  ("discarded_fraction", "steps discarded after failure"), ("wait_fraction", "learner waiting")]
+GEOMETRIC_PANELS = [
+    ("episode_return", "episode return"),
+    ("episode_length", "episode length (steps)"),
+    ("invalid_fraction", "episodes ending invalid (fraction)"),
+    ("sps", "env steps / s"),
+]
+PLANNER_PANELS = [
+    ("mean_coverage", "mean contact-plan coverage"),
+    ("full_coverage_fraction", "fully covered paths"),
+    ("discarded_fraction", "steps discarded after failure"),
+    ("wait_fraction", "learner waiting"),
+]
 
 
 def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[str], dict]:
@@ -66,18 +80,35 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     episodes = arena_episodes(policy, field, n=n_episodes, seed=1)
     failures = failure_breakdown(field, episodes, config.env.reachability)
     show = min(24, n_episodes)
-    colors = ["tab:blue" if episodes.lengths[k] == episodes.poses.shape[1] else "tab:red" for k in range(show)]
-    plot_paths(arena, [episodes.poses[k, : episodes.lengths[k]] for k in range(show)],
-               out / "rollouts_arena.png", title=f"{arena.name}: {show} episodes (red: ended invalid)", colors=colors)
+    colors = [
+        "tab:blue" if episodes.lengths[k] == episodes.poses.shape[1] else "tab:red" for k in range(show)
+    ]
+    plot_paths(
+        arena,
+        [episodes.poses[k, : episodes.lengths[k]] for k in range(show)],
+        out / "rollouts_arena.png",
+        title=f"{arena.name}: {show} episodes (red: ended invalid)",
+        colors=colors,
+    )
     ground = load_terrain(resolve_data_path("terrains/eval_ground.toml"))
     speed = ground_speed(policy, ground, heightfield_from_terrain(ground, config.env), n=n_episodes, seed=2)
-    plot_paths(ground, speed.guides[:16], out / "rollouts_ground.png",
-               title=f"{ground.name}: 16 random headings, 400 steps")
-    results = {"env_steps": policy.env_steps, "wall_s": records[-1]["wall_s"] if records else None,
-               "final_sps": records[-1]["sps"] if records else None, "ground_mean_speed": speed.mean_speed,
-               "ground_invalid_fraction": speed.invalid_fraction, "arena_valid_fraction": episodes.valid_fraction,
-               "arena_stopped_fraction_of_valid": episodes.stopped_fraction,
-               "arena_mean_progress_m": episodes.mean_progress, "episodes_per_metric": n_episodes}
+    plot_paths(
+        ground,
+        speed.guides[:16],
+        out / "rollouts_ground.png",
+        title=f"{ground.name}: 16 random headings, 400 steps",
+    )
+    results = {
+        "env_steps": policy.env_steps,
+        "wall_s": records[-1]["wall_s"] if records else None,
+        "final_sps": records[-1]["sps"] if records else None,
+        "ground_mean_speed": speed.mean_speed,
+        "ground_invalid_fraction": speed.invalid_fraction,
+        "arena_valid_fraction": episodes.valid_fraction,
+        "arena_stopped_fraction_of_valid": episodes.stopped_fraction,
+        "arena_mean_progress_m": episodes.mean_progress,
+        "episodes_per_metric": n_episodes,
+    }
     ok = lambda good: "pass" if good else "FAIL"  # noqa: E731
     last = records[-1] if records else {}
     lines = [
@@ -114,8 +145,9 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     return lines, results
 
 
-def _planner_section(geometric_dir: Path, planner_dir: Path, out: Path, compare_starts: int,
-                     workers: int) -> tuple[list[str], dict]:
+def _planner_section(
+    geometric_dir: Path, planner_dir: Path, out: Path, compare_starts: int, workers: int
+) -> tuple[list[str], dict]:
     """Markdown lines of the planner phase: curves and coverage before/after over the same starts."""
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.eval.planner_compare import arena_coverage, scenario_coverage
@@ -124,14 +156,27 @@ def _planner_section(geometric_dir: Path, planner_dir: Path, out: Path, compare_
 
     records = read_metrics(planner_dir)
     if records:
-        plot_curves(records, PLANNER_PANELS, out / "planner_curves.png", steps_scale=1e3,
-                    steps_label="kept env steps (k)", color="tab:green")
+        plot_curves(
+            records,
+            PLANNER_PANELS,
+            out / "planner_curves.png",
+            steps_scale=1e3,
+            steps_label="kept env steps (k)",
+            color="tab:green",
+        )
     rows, results = [], {}
     for label, run in (("geometric", geometric_dir), ("planner fine-tuned", planner_dir)):
         policy = load_policy(run)
         arena = load_terrain(policy.config.terrain_path())
-        cov = {"training arena": arena_coverage(policy, arena, heightfield_from_terrain(arena, policy.config.env),
-                                                n=compare_starts, workers=workers)}
+        cov = {
+            "training arena": arena_coverage(
+                policy,
+                arena,
+                heightfield_from_terrain(arena, policy.config.env),
+                n=compare_starts,
+                workers=workers,
+            )
+        }
         cov.update(scenario_coverage(run, ["bridge", "stairs"], n_starts=compare_starts, workers=workers))
         results[label] = {k: vars(v) for k, v in cov.items()}
         rows += [f"| {label} | {name} | {c.n} | {c.row()} |" for name, c in cov.items()]
@@ -160,18 +205,32 @@ def _baseline_section(planner_dir: Path, out: Path, n_starts: int, workers: int)
     from leas_jax.eval.evaluate import evaluate
     from leas_jax.eval.tables import table_ii_markdown
 
-    report = evaluate(["ground"], methods=["rblin", "rbkino", "leas"], checkpoint=planner_dir,
-                      out=out / "evaluation", n_starts=n_starts, workers=workers, progress=False)
-    lines = ["## Against the baselines", "",
-             f"{n_starts} trajectories per Table II cell (the paper: 60), the policy above against RBLin and "
-             "RBKino; full outputs in `evaluation/`.", "",
-             table_ii_markdown(report["table_ii"]), "",
-             *[f"![{name}](evaluation/{name})" for name in report.get("figures", [])], ""]
+    report = evaluate(
+        ["ground"],
+        methods=["rblin", "rbkino", "leas"],
+        checkpoint=planner_dir,
+        out=out / "evaluation",
+        n_starts=n_starts,
+        workers=workers,
+        progress=False,
+    )
+    lines = [
+        "## Against the baselines",
+        "",
+        f"{n_starts} trajectories per Table II cell (the paper: 60), the policy above against RBLin and "
+        "RBKino; full outputs in `evaluation/`.",
+        "",
+        table_ii_markdown(report["table_ii"]),
+        "",
+        *[f"![{name}](evaluation/{name})" for name in report.get("figures", [])],
+        "",
+    ]
     return lines, {"table_ii": report["table_ii"]}
 
 
-def write_report(out: Path, n_episodes: int = 256, compare_starts: int = 24, baseline_starts: int = 10,
-                 workers: int = 2) -> Path:
+def write_report(
+    out: Path, n_episodes: int = 256, compare_starts: int = 24, baseline_starts: int = 10, workers: int = 2
+) -> Path:
     """Evaluate a `leas run` directory and write report.md, eval.json and PNGs into it.
 
     `out` holds `geometric/` (and, after planner fine-tuning, `planner/`), or

@@ -1,6 +1,6 @@
 """Evaluation scenarios of the paper (§IV-B to §IV-D) and their seeded start draws.
 
-A scenario is a terrain file with a `[scenario]` table (DESIGN §4). It is run
+A scenario is a terrain file with a `[scenario]` table (docs/design.md §4). It is run
 as one or more *cells*: a yaw range and a speed range for the starts. The
 ground scenario is the paper's Table II, nine cells (three yaw ranges x three
 initial speeds); every other scenario is one cell, its own table's.
@@ -90,7 +90,9 @@ def scenario_file(name: str) -> Path:
     from leas_jax.training.config import resolve_data_path
 
     if name not in SCENARIOS:
-        raise UsageError(f"--scenario: unknown scenario {name!r} (expected one of {', '.join(SCENARIOS)}, all)")
+        raise UsageError(
+            f"--scenario: unknown scenario {name!r} (expected one of {', '.join(SCENARIOS)}, all)"
+        )
     return resolve_data_path(f"terrains/eval_{name}.toml")
 
 
@@ -102,8 +104,11 @@ def cells_for(name: str, scenario) -> list[Cell]:
         scenario: the terrain's `Scenario`.
     """
     if name == "ground":
-        return [Cell(f"yaw {lo:g}..{hi:g} deg, v {v:g} m/s", (lo, hi), (v, v))
-                for lo, hi in TABLE_II_YAWS for v in TABLE_II_SPEEDS]
+        return [
+            Cell(f"yaw {lo:g}..{hi:g} deg, v {v:g} m/s", (lo, hi), (v, v))
+            for lo, hi in TABLE_II_YAWS
+            for v in TABLE_II_SPEEDS
+        ]
     yaw = tuple(float(a) for a in scenario.start_yaw_deg)
     speed = tuple(float(a) for a in scenario.start_speed)
     return [Cell(f"yaw {yaw[0]:g}..{yaw[1]:g} deg, v {speed[0]:g}..{speed[1]:g} m/s", yaw, speed)]
@@ -115,8 +120,9 @@ def route(scenario) -> np.ndarray:
     return np.array(points + [np.asarray(scenario.target, np.float64)])
 
 
-def draw_starts(scenario, cell: Cell, n: int, seed: int, field, nominal_root_height: float,
-                reachability=None) -> Starts:
+def draw_starts(
+    scenario, cell: Cell, n: int, seed: int, field, nominal_root_height: float, reachability=None
+) -> Starts:
     """Seeded starts of one cell: uniform in the start region, yaw offset and speed ranges.
 
     Starts failing the reachability condition (or standing over the void) are
@@ -148,13 +154,14 @@ def draw_starts(scenario, cell: Cell, n: int, seed: int, field, nominal_root_hei
             offset = rng.uniform(*cell.yaw_deg)
             speed = rng.uniform(*cell.speed)
             yaw = math.atan2(aim[1] - xy[1], aim[0] - xy[0]) + math.radians(offset)
-            pose, ok = lift_checked(field, np.array([[xy[0], xy[1], yaw]]),
-                                    nominal_root_height, reach)
+            pose, ok = lift_checked(field, np.array([[xy[0], xy[1], yaw]]), nominal_root_height, reach)
             if ok[0]:
                 break
         else:
-            raise UsageError(f"scenario start_region {region.tolist()}: no valid start after "
-                             f"{_START_ATTEMPTS} draws (start {k})")
+            raise UsageError(
+                f"scenario start_region {region.tolist()}: no valid start after "
+                f"{_START_ATTEMPTS} draws (start {k})"
+            )
         poses.append(pose[0])
         speeds.append(speed)
         offsets.append(offset)
@@ -168,14 +175,17 @@ def draw_starts(scenario, cell: Cell, n: int, seed: int, field, nominal_root_hei
 HORIZON_FACTOR = 2.5
 
 
-def leas_horizon(start_xy, points, target_speed: float, timestep: float, minimum: int,
-                 factor: float = HORIZON_FACTOR) -> int:
+def leas_horizon(
+    start_xy, points, target_speed: float, timestep: float, minimum: int, factor: float = HORIZON_FACTOR
+) -> int:
     """LeaS horizon (steps) for a route: `factor` x the time to walk it at the target speed,
     >= `minimum`.
 
     The paper's episodes last 400 steps (40 s, 7.2 m at 0.18 m/s); the bridge and
     circuit routes are longer, so the horizon grows with the route length.
     """
-    polyline = np.concatenate([np.asarray(start_xy, np.float64).reshape(1, 2), np.asarray(points).reshape(-1, 2)])
+    polyline = np.concatenate(
+        [np.asarray(start_xy, np.float64).reshape(1, 2), np.asarray(points).reshape(-1, 2)]
+    )
     length = float(np.sum(np.hypot(*np.diff(polyline, axis=0).T)))
     return max(int(minimum), int(math.ceil(factor * length / (target_speed * timestep))))

@@ -52,8 +52,15 @@ def hole_terrain(width: float):
     return loads_terrain(hole_terrain_toml(width), source=f"<hole sweep, width {width:g} m>")
 
 
-def hole_width_sweep(widths=DEFAULT_WIDTHS, methods=DEFAULT_METHODS, checkpoint=None, n_starts: int | None = None,
-                     workers: int | None = None, out=None, progress: bool = True) -> dict:
+def hole_width_sweep(
+    widths=DEFAULT_WIDTHS,
+    methods=DEFAULT_METHODS,
+    checkpoint=None,
+    n_starts: int | None = None,
+    workers: int | None = None,
+    out=None,
+    progress: bool = True,
+) -> dict:
     """Success and coverage of each method on holes of each width.
 
     Args:
@@ -80,16 +87,27 @@ def hole_width_sweep(widths=DEFAULT_WIDTHS, methods=DEFAULT_METHODS, checkpoint=
     env = policy.config.env if policy is not None else EnvConfig()
     rows, results = [], []
     for width in widths:
-        result = run_scenario(f"hole_{width:g}m", hole_terrain(width), tuple(methods), policy, n_starts, workers,
-                              progress=progress)
+        result = run_scenario(
+            f"hole_{width:g}m",
+            hole_terrain(width),
+            tuple(methods),
+            policy,
+            n_starts,
+            workers,
+            progress=progress,
+        )
         summary = result.summary()
         rows += [{"width": width, "method": m, **summary[m]["all"]} for m in methods]
         results.append(result)
-    report = {"format": "leas-hole-sweep-v1",
-              "policy": None if policy is None else {"source": policy.source, "env_steps": int(policy.env_steps)},
-              "widths": list(widths), "methods": list(methods),
-              "view_half_width": env.heightmap.lateral_step * env.heightmap.lateral_half_count,
-              "seconds": round(time.perf_counter() - began, 3), "rows": rows}
+    report = {
+        "format": "leas-hole-sweep-v1",
+        "policy": None if policy is None else {"source": policy.source, "env_steps": int(policy.env_steps)},
+        "widths": list(widths),
+        "methods": list(methods),
+        "view_half_width": env.heightmap.lateral_step * env.heightmap.lateral_half_count,
+        "seconds": round(time.perf_counter() - began, 3),
+        "rows": rows,
+    }
     if out is not None:
         write_outputs(Path(out), report, results)
     return report
@@ -100,8 +118,10 @@ def markdown(report: dict) -> str:
     from leas_jax.eval.tables import METHOD_LABELS
 
     methods = report["methods"]
-    lines = ["| hole width (m) | " + " | ".join(METHOD_LABELS.get(m, m) for m in methods) + " |",
-             "|---|" + "---|" * len(methods)]
+    lines = [
+        "| hole width (m) | " + " | ".join(METHOD_LABELS.get(m, m) for m in methods) + " |",
+        "|---|" + "---|" * len(methods),
+    ]
     for width in report["widths"]:
         cells = []
         for method in methods:
@@ -109,8 +129,10 @@ def markdown(report: dict) -> str:
             cells.append(f"{row['success']:.1f} / {row['coverage']:.1f} %")
         lines.append(f"| {width:g} | " + " | ".join(cells) + " |")
     lines.append("")
-    lines.append(f"Success / mean coverage, {report['rows'][0]['n']} starts per width; the heightmap sees "
-                 f"{report['view_half_width']:g} m to either side of the root.")
+    lines.append(
+        f"Success / mean coverage, {report['rows'][0]['n']} starts per width; the heightmap sees "
+        f"{report['view_half_width']:g} m to either side of the root."
+    )
     return "\n".join(lines) + "\n"
 
 
@@ -127,13 +149,26 @@ def sweep_figure(report: dict):
     for method in report["methods"]:
         chosen = sorted((r for r in report["rows"] if r["method"] == method), key=lambda r: r["width"])
         widths = np.array([r["width"] for r in chosen])
-        line, = axes.plot(widths, [r["success"] for r in chosen], "o-", label=f"{METHOD_LABELS.get(method, method)}"
-                                                                             " success")
-        axes.plot(widths, [r["coverage"] for r in chosen], ":", color=line.get_color(),
-                  label=f"{METHOD_LABELS.get(method, method)} coverage")
+        (line,) = axes.plot(
+            widths, [r["success"] for r in chosen], "o-", label=f"{METHOD_LABELS.get(method, method)} success"
+        )
+        axes.plot(
+            widths,
+            [r["coverage"] for r in chosen],
+            ":",
+            color=line.get_color(),
+            label=f"{METHOD_LABELS.get(method, method)} coverage",
+        )
     axes.axvline(2 * report["view_half_width"], color="grey", linestyle="--", linewidth=1)
-    axes.text(2 * report["view_half_width"], 50, " heightmap width", color="grey", fontsize=8, rotation=90,
-              va="center")
+    axes.text(
+        2 * report["view_half_width"],
+        50,
+        " heightmap width",
+        color="grey",
+        fontsize=8,
+        rotation=90,
+        va="center",
+    )
     axes.set_xlabel("hole width across the line to the target (m)")
     axes.set_ylabel("%")
     axes.set_ylim(-3, 103)

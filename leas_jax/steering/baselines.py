@@ -33,7 +33,7 @@ _VOID_MARGIN = 1e-3
 class BaselineConfig:
     """Parameters of the baseline steering methods.
 
-    Defaults are the LeaS environment's (DESIGN §5) so that every method shares
+    Defaults are the LeaS environment's (docs/design.md §5) so that every method shares
     the timestep and the target speed (paper §IV-B: "The timestep and the norm
     of target velocities are the same for all three methods").
     """
@@ -50,10 +50,15 @@ class BaselineConfig:
     nominal_root_height: float = 1.0  # m above the terrain, EnvConfig.nominal_root_height
 
     @classmethod
-    def from_env(cls, env: EnvConfig, **overrides) -> "BaselineConfig":
+    def from_env(cls, env: EnvConfig, **overrides) -> BaselineConfig:
         """Config sharing the env's timestep, target speed, a_max and root height."""
-        values = dict(timestep=env.timestep, target_speed=env.target_speed, v_max=env.target_speed,
-                      a_max=env.a_max, nominal_root_height=env.nominal_root_height)
+        values = dict(
+            timestep=env.timestep,
+            target_speed=env.target_speed,
+            v_max=env.target_speed,
+            a_max=env.a_max,
+            nominal_root_height=env.nominal_root_height,
+        )
         values.update(overrides)
         return cls(**values)
 
@@ -79,8 +84,9 @@ def _padded(array: np.ndarray) -> tuple[np.ndarray, int]:
 
 
 @functools.partial(jax.jit, static_argnums=(2, 3, 4))
-def _lift_valid(field: Heightfield, planar: jax.Array, height: float, config: ReachabilityConfig,
-                solid_ground: bool):
+def _lift_valid(
+    field: Heightfield, planar: jax.Array, height: float, config: ReachabilityConfig, solid_ground: bool
+):
     ground = sample_bilinear(field, planar[:, :2])
     poses = jnp.stack([planar[:, 0], planar[:, 1], ground + height, planar[:, 2]], axis=1)
     ok = jax.vmap(lambda pose: reachability.valid(field, pose, config))(poses)
@@ -89,9 +95,13 @@ def _lift_valid(field: Heightfield, planar: jax.Array, height: float, config: Re
     return poses, ok
 
 
-def lift_checked(field: Heightfield, planar, nominal_root_height: float,
-                 config: ReachabilityConfig = ReachabilityConfig(),
-                 solid_ground: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def lift_checked(
+    field: Heightfield,
+    planar,
+    nominal_root_height: float,
+    config: ReachabilityConfig = ReachabilityConfig(),
+    solid_ground: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
     """`lift` and `valid_poses` in one jitted call (the RRT's inner loop).
 
     The reachability rasters treat the void under the terrain (`void_height`)
@@ -111,7 +121,9 @@ def lift_checked(field: Heightfield, planar, nominal_root_height: float,
     """
     planar = np.asarray(planar, np.float64).reshape(-1, 3)
     padded, n = _padded(planar.astype(np.float32))
-    poses, ok = _lift_valid(field, jnp.asarray(padded), float(nominal_root_height), config, bool(solid_ground))
+    poses, ok = _lift_valid(
+        field, jnp.asarray(padded), float(nominal_root_height), config, bool(solid_ground)
+    )
     # to NumPy before slicing: slicing the jax array by a new `n` compiles a new XLA slice each time
     z = np.asarray(poses, np.float64)[:n, 2]
     return np.column_stack([planar[:, 0], planar[:, 1], z, planar[:, 2]]), np.asarray(ok)[:n]
@@ -149,7 +161,7 @@ def lift(field: Heightfield, planar, nominal_root_height: float) -> np.ndarray:
 
 
 def valid_poses(field: Heightfield, poses, config: ReachabilityConfig = ReachabilityConfig()) -> np.ndarray:
-    """Reachability condition (DESIGN §5) of many root poses at once.
+    """Reachability condition (docs/design.md §5) of many root poses at once.
 
     Args:
         field: heightfield with reachability rasters built with `config`'s radii.

@@ -15,22 +15,32 @@ def _floats(count: int, name: str):
         try:
             values = [float(v) for v in text.split(",")]
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} expects {count} comma-separated numbers, got {text!r}") from None
+            raise argparse.ArgumentTypeError(
+                f"{name} expects {count} comma-separated numbers, got {text!r}"
+            ) from None
         if len(values) != count or not np.all(np.isfinite(values)):
-            raise argparse.ArgumentTypeError(f"{name} expects {count} finite comma-separated numbers, got {text!r}")
+            raise argparse.ArgumentTypeError(
+                f"{name} expects {count} finite comma-separated numbers, got {text!r}"
+            )
         return values
+
     return parse
 
 
 def save_guide(path: Path, guide: np.ndarray, timestep: float, terrain_text: str, target) -> None:
-    """Write a guide file (DESIGN §6): guide [T, 4], timestep, terrain text, target [2]; atomic."""
+    """Write a guide file (docs/design.md §6): guide [T, 4], timestep, terrain text, target [2]; atomic."""
     import io
 
     from leas_jax.training.checkpoint import atomic_write_bytes
 
     buffer = io.BytesIO()
-    np.savez(buffer, guide=np.asarray(guide, np.float64), timestep=np.float64(timestep),
-             terrain=np.array(terrain_text), target=np.asarray(target, np.float64))
+    np.savez(
+        buffer,
+        guide=np.asarray(guide, np.float64),
+        timestep=np.float64(timestep),
+        terrain=np.array(terrain_text),
+        target=np.asarray(target, np.float64),
+    )
     atomic_write_bytes(path, buffer.getvalue())
 
 
@@ -54,8 +64,14 @@ def plot_paths(terrain, paths, path: Path, title: str = "", colors=None, target=
         color = colors[k] if colors is not None else "tab:blue"
         axes.plot(guide[:, 0], guide[:, 1], "-", color=color, linewidth=1.2)
         axes.plot(guide[0, 0], guide[0, 1], "o", color=color, markersize=4)
-        axes.arrow(guide[0, 0], guide[0, 1], 0.3 * np.cos(guide[0, 3]), 0.3 * np.sin(guide[0, 3]),
-                   width=0.02, color="black")
+        axes.arrow(
+            guide[0, 0],
+            guide[0, 1],
+            0.3 * np.cos(guide[0, 3]),
+            0.3 * np.sin(guide[0, 3]),
+            width=0.02,
+            color="black",
+        )
     if target is not None:
         axes.plot(*target, "*", color="red", markersize=14, markeredgecolor="black")
     if title:
@@ -80,31 +96,52 @@ def cmd_rollout(args) -> int:
     for name, (px, py) in (("--start", (x, y)), ("--target", tuple(args.target))):
         if not (xmin <= px <= xmax and ymin <= py <= ymax):
             raise UsageError(f"{name} ({px:g}, {py:g}) lies outside the terrain bounds of {args.terrain}")
-    guide = rollout(policy, terrain, (x, y, np.deg2rad(yaw) if args.degrees else yaw), args.target,
-                    speed=args.speed, max_steps=args.max_steps)
+    guide = rollout(
+        policy,
+        terrain,
+        (x, y, np.deg2rad(yaw) if args.degrees else yaw),
+        args.target,
+        speed=args.speed,
+        max_steps=args.max_steps,
+    )
     save_guide(out, guide, policy.config.env.timestep, terrain.text, args.target)
     png = out.with_suffix(".png")
     plot_paths(terrain, [guide], png, title=f"LeaS rollout: {len(guide)} poses", target=args.target)
     distance = float(np.linalg.norm(guide[-1, :2] - np.asarray(args.target)))
-    print(f"guide: {len(guide)} poses, {len(guide) * policy.config.env.timestep:.1f} s, "
-          f"ends {distance:.2f} m from the target -> {out}, {png}")
+    print(
+        f"guide: {len(guide)} poses, {len(guide) * policy.config.env.timestep:.1f} s, "
+        f"ends {distance:.2f} m from the target -> {out}, {png}"
+    )
     if args.plan:
         from leas_jax.contacts import plan_contacts
+
         plan = plan_contacts(terrain, guide, policy.config.env.timestep)
         plan.save(args.plan)
-        print(f"contact plan: coverage {plan.coverage:.3f}, last valid index {plan.last_valid_index} -> {args.plan}")
+        print(
+            f"contact plan: coverage {plan.coverage:.3f}, last valid index {plan.last_valid_index} -> {args.plan}"
+        )
     return 0
 
 
 def register(subparsers) -> None:
-    parser = subparsers.add_parser("rollout", help="guide path of a trained policy",
-                                   description="Roll a trained LeaS policy from a start to a target; write the "
-                                               "guide file (.npz, DESIGN §6) and a top-down PNG beside it.")
+    parser = subparsers.add_parser(
+        "rollout",
+        help="guide path of a trained policy",
+        description="Roll a trained LeaS policy from a start to a target; write the "
+        "guide file (.npz, docs/design.md §6) and a top-down PNG beside it.",
+    )
     parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
     parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain TOML file")
-    parser.add_argument("--start", required=True, type=_floats(3, "--start"), metavar="X,Y,YAW",
-                        help="start position (m) and yaw (rad, or degrees with --degrees)")
-    parser.add_argument("--target", required=True, type=_floats(2, "--target"), metavar="X,Y", help="target (m)")
+    parser.add_argument(
+        "--start",
+        required=True,
+        type=_floats(3, "--start"),
+        metavar="X,Y,YAW",
+        help="start position (m) and yaw (rad, or degrees with --degrees)",
+    )
+    parser.add_argument(
+        "--target", required=True, type=_floats(2, "--target"), metavar="X,Y", help="target (m)"
+    )
     parser.add_argument("--speed", type=float, default=0.0, help="initial speed along the heading (m/s)")
     parser.add_argument("--max-steps", type=int, default=None, help="horizon (default 400)")
     parser.add_argument("--degrees", action="store_true", help="YAW of --start is in degrees")

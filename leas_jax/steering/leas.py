@@ -47,8 +47,14 @@ class RolloutResult:
 
 
 @functools.lru_cache(maxsize=16)
-def _compiled_rollout(env_config: EnvConfig, policy_key, max_steps: int, switch_distance: float,
-                      stop_at_target: bool, stop_at_invalid: bool):
+def _compiled_rollout(
+    env_config: EnvConfig,
+    policy_key,
+    max_steps: int,
+    switch_distance: float,
+    stop_at_target: bool,
+    stop_at_invalid: bool,
+):
     """Jitted batch rollout for one env config and horizon (cached)."""
     policy = policy_key.policy
     env_config = dataclasses.replace(env_config, stop_at_target=False, episode_length=max_steps + 1)
@@ -81,7 +87,13 @@ def _compiled_rollout(env_config: EnvConfig, policy_key, max_steps: int, switch_
                 alive_next = keep & ~(hit_last & stop_at_target)
                 return (state, wp_index, alive_next, reached, invalid), (pose, keep)
 
-            init = (state, jnp.zeros((), jnp.int32), jnp.asarray(True), jnp.asarray(False), jnp.asarray(False))
+            init = (
+                state,
+                jnp.zeros((), jnp.int32),
+                jnp.asarray(True),
+                jnp.asarray(False),
+                jnp.asarray(False),
+            )
             (_, _, _, reached, invalid), (poses, kept) = jax.lax.scan(step, init, None, length=max_steps)
             poses = jnp.concatenate([start[None], poses], axis=0)
             return poses, 1 + kept.sum(), invalid, reached
@@ -111,9 +123,17 @@ def start_poses(field: Heightfield, starts_xy_yaw: np.ndarray, nominal_root_heig
     return np.stack([starts[:, 0], starts[:, 1], z, starts[:, 2]], axis=1)
 
 
-def rollout_batch(policy, field: Heightfield, starts: np.ndarray, targets, speeds=None,
-                  max_steps: int | None = None, switch_distance: float | None = None,
-                  stop_at_target: bool = True, stop_at_invalid: bool = True) -> RolloutResult:
+def rollout_batch(
+    policy,
+    field: Heightfield,
+    starts: np.ndarray,
+    targets,
+    speeds=None,
+    max_steps: int | None = None,
+    switch_distance: float | None = None,
+    stop_at_target: bool = True,
+    stop_at_invalid: bool = True,
+) -> RolloutResult:
     """Roll the deterministic policy from N starts.
 
     Args:
@@ -140,19 +160,35 @@ def rollout_batch(policy, field: Heightfield, starts: np.ndarray, targets, speed
         waypoints = waypoints[:, None, :]
     if waypoints.shape[0] != n or waypoints.shape[-1] != 2:
         raise UsageError(f"targets must be [N, 2] or [N, W, 2] with N = {n}, got shape {waypoints.shape}")
-    speeds = np.zeros(n, np.float32) if speeds is None else np.broadcast_to(np.asarray(speeds, np.float32), (n,))
+    speeds = (
+        np.zeros(n, np.float32) if speeds is None else np.broadcast_to(np.asarray(speeds, np.float32), (n,))
+    )
     max_steps = int(max_steps or env_config.episode_length)
     switch = float(switch_distance or env_config.target_reached_distance)
-    run = _compiled_rollout(env_config, _PolicyKey(policy), max_steps, switch, bool(stop_at_target),
-                            bool(stop_at_invalid))
+    run = _compiled_rollout(
+        env_config, _PolicyKey(policy), max_steps, switch, bool(stop_at_target), bool(stop_at_invalid)
+    )
     n_wp = np.full(n, waypoints.shape[1], np.int32)
     poses, lengths, invalid, reached = jax.device_get(run(field, starts, speeds, waypoints, n_wp))
-    return RolloutResult(poses=np.asarray(poses), lengths=np.asarray(lengths), invalid=np.asarray(invalid),
-                         reached=np.asarray(reached), timestep=env_config.timestep)
+    return RolloutResult(
+        poses=np.asarray(poses),
+        lengths=np.asarray(lengths),
+        invalid=np.asarray(invalid),
+        reached=np.asarray(reached),
+        timestep=env_config.timestep,
+    )
 
 
-def rollout(policy, terrain, start, target, speed: float = 0.0, max_steps: int | None = None,
-            waypoints=None, stop_at_target: bool = True) -> np.ndarray:
+def rollout(
+    policy,
+    terrain,
+    start,
+    target,
+    speed: float = 0.0,
+    max_steps: int | None = None,
+    waypoints=None,
+    stop_at_target: bool = True,
+) -> np.ndarray:
     """Guide path of the policy from one start to a target.
 
     Args:
@@ -173,5 +209,7 @@ def rollout(policy, terrain, start, target, speed: float = 0.0, max_steps: int |
     points = np.asarray(target, np.float32).reshape(1, 2)
     if waypoints is not None:
         points = np.concatenate([np.asarray(waypoints, np.float32).reshape(-1, 2), points])
-    result = rollout_batch(policy, field, pose, points[None], [speed], max_steps, stop_at_target=stop_at_target)
+    result = rollout_batch(
+        policy, field, pose, points[None], [speed], max_steps, stop_at_target=stop_at_target
+    )
     return result.guide(0)

@@ -162,10 +162,19 @@ class KinoProfile:
         s1 = np.minimum(t, self.t1)
         sc = np.clip(t - self.t1, 0.0, self.tc)
         s2 = np.clip(t - self.t1 - self.tc, 0.0, self.t2)
-        pos = (self.p0 + self.v0 * s1 + 0.5 * self.a1 * s1**2 + self.vc * sc
-               + self.vc * s2 + 0.5 * self.a2 * s2**2)
-        vel = np.where(t <= self.t1, self.v0 + self.a1 * s1,
-                       np.where(t <= self.t1 + self.tc, self.vc, self.vc + self.a2 * s2))
+        pos = (
+            self.p0
+            + self.v0 * s1
+            + 0.5 * self.a1 * s1**2
+            + self.vc * sc
+            + self.vc * s2
+            + 0.5 * self.a2 * s2**2
+        )
+        vel = np.where(
+            t <= self.t1,
+            self.v0 + self.a1 * s1,
+            np.where(t <= self.t1 + self.tc, self.vc, self.vc + self.a2 * s2),
+        )
         return pos, vel
 
 
@@ -207,8 +216,9 @@ def sample_times(duration: float, timestep: float) -> np.ndarray:
     return np.minimum(np.arange(steps + 1) * timestep, duration)
 
 
-def rbkino_states(start_xy, start_velocity, goal_xy, goal_velocity=(0.0, 0.0),
-                  config: BaselineConfig = BaselineConfig()) -> tuple[np.ndarray, np.ndarray]:
+def rbkino_states(
+    start_xy, start_velocity, goal_xy, goal_velocity=(0.0, 0.0), config: BaselineConfig = BaselineConfig()
+) -> tuple[np.ndarray, np.ndarray]:
     """Sampled RBKino states between two planar states.
 
     Args:
@@ -223,7 +233,9 @@ def rbkino_states(start_xy, start_velocity, goal_xy, goal_velocity=(0.0, 0.0),
     return profile.state(sample_times(profile.duration, config.timestep))
 
 
-def rbkino_planar(start, goal, initial_speed: float = 0.0, config: BaselineConfig = BaselineConfig()) -> np.ndarray:
+def rbkino_planar(
+    start, goal, initial_speed: float = 0.0, config: BaselineConfig = BaselineConfig()
+) -> np.ndarray:
     """RBKino planar path: start at `initial_speed` along the start yaw, end at rest on the goal.
 
     Args:
@@ -244,8 +256,9 @@ def rbkino_planar(start, goal, initial_speed: float = 0.0, config: BaselineConfi
     return np.column_stack([pos, yaw])
 
 
-def rbkino(field: Heightfield, start, goal, initial_speed: float = 0.0,
-           config: BaselineConfig = BaselineConfig()) -> np.ndarray:
+def rbkino(
+    field: Heightfield, start, goal, initial_speed: float = 0.0, config: BaselineConfig = BaselineConfig()
+) -> np.ndarray:
     """RBKino guide path on the terrain.
 
     Args:
@@ -261,8 +274,9 @@ def rbkino(field: Heightfield, start, goal, initial_speed: float = 0.0,
     return lift(field, rbkino_planar(start, goal, initial_speed, config), config.nominal_root_height)
 
 
-def rbkino_through(field: Heightfield, start, points, initial_speed: float = 0.0,
-                   config: BaselineConfig = BaselineConfig()) -> np.ndarray:
+def rbkino_through(
+    field: Heightfield, start, points, initial_speed: float = 0.0, config: BaselineConfig = BaselineConfig()
+) -> np.ndarray:
     """RBKino chained through waypoints, stopping at each one (HPP connects waypoints at rest).
 
     Args:

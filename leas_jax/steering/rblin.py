@@ -47,8 +47,9 @@ def braking_distance_steps(speed: float, a_max: float, timestep: float) -> tuple
     return speed * t - 0.5 * a_max * t**2, speed - a_max * t
 
 
-def rblin_planar(start, goal, initial_speed: float = 0.0, config: BaselineConfig = BaselineConfig(),
-                 brake: bool = True) -> np.ndarray:
+def rblin_planar(
+    start, goal, initial_speed: float = 0.0, config: BaselineConfig = BaselineConfig(), brake: bool = True
+) -> np.ndarray:
     """RBLin planar path from a start pose to a goal point.
 
     Args:
@@ -87,8 +88,14 @@ def rblin_planar(start, goal, initial_speed: float = 0.0, config: BaselineConfig
     return planar
 
 
-def rblin(field: Heightfield, start, goal, initial_speed: float = 0.0,
-          config: BaselineConfig = BaselineConfig(), brake: bool = True) -> np.ndarray:
+def rblin(
+    field: Heightfield,
+    start,
+    goal,
+    initial_speed: float = 0.0,
+    config: BaselineConfig = BaselineConfig(),
+    brake: bool = True,
+) -> np.ndarray:
     """RBLin guide path on the terrain.
 
     Args:
@@ -105,8 +112,14 @@ def rblin(field: Heightfield, start, goal, initial_speed: float = 0.0,
     return lift(field, planar, config.nominal_root_height)
 
 
-def rblin_through(field: Heightfield, start, points, initial_speed: float = 0.0,
-                  config: BaselineConfig = BaselineConfig(), brake: bool = True) -> np.ndarray:
+def rblin_through(
+    field: Heightfield,
+    start,
+    points,
+    initial_speed: float = 0.0,
+    config: BaselineConfig = BaselineConfig(),
+    brake: bool = True,
+) -> np.ndarray:
     """RBLin chained through waypoints: rotate, walk, rotate, walk, ... ending on the last point.
 
     Args:

@@ -36,7 +36,8 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field as dataclass_field
+from dataclasses import dataclass
+from dataclasses import field as dataclass_field
 
 import numpy as np
 
@@ -139,7 +140,9 @@ class _Problem:
 
     def valid_positions(self, xy: np.ndarray, yaw: np.ndarray) -> np.ndarray:
         """[K] validity of root positions xy [K, 2] (world) heading yaw [K] (rad), one jitted check."""
-        _, ok = lift_checked(self.field, np.column_stack([xy, yaw]), self.config.nominal_root_height, self.reach)
+        _, ok = lift_checked(
+            self.field, np.column_stack([xy, yaw]), self.config.nominal_root_height, self.reach
+        )
         return np.asarray(ok, bool)
 
     def valid_state(self, state) -> bool:
@@ -162,8 +165,10 @@ def _nearest(tree: _Tree, target: np.ndarray, config: BaselineConfig) -> int:
         a, b = states, target[None, :]
     else:
         a, b = target[None, :], states
-    times = np.maximum(min_time(a[:, 0], b[:, 0], a[:, 2], b[:, 2], config.v_max, config.a_max),
-                       min_time(a[:, 1], b[:, 1], a[:, 3], b[:, 3], config.v_max, config.a_max))
+    times = np.maximum(
+        min_time(a[:, 0], b[:, 0], a[:, 2], b[:, 2], config.v_max, config.a_max),
+        min_time(a[:, 1], b[:, 1], a[:, 3], b[:, 3], config.v_max, config.a_max),
+    )
     return int(np.argmin(times))
 
 
@@ -188,8 +193,9 @@ def _sample(rng: np.random.Generator, bounds: np.ndarray, rrt: RRTConfig, proble
     return state
 
 
-def _bridge_sample(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, rrt: RRTConfig,
-                   problem: _Problem) -> np.ndarray | None:
+def _bridge_sample(
+    rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, rrt: RRTConfig, problem: _Problem
+) -> np.ndarray | None:
     """Bridge test over `sample_attempts` draws at once: an invalid position p, another one q at
     a distance uniform in `bridge_length` in a uniform direction, and their midpoint valid.
 
@@ -207,7 +213,7 @@ def _bridge_sample(rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray, rrt
     heading = np.arctan2(along[:, 1], along[:, 0])
     valid = problem.valid_positions(np.concatenate([p, q, middle]), np.tile(heading, 3))
     inside = np.all((middle >= lo) & (middle <= hi), axis=1)
-    passes = np.flatnonzero(~valid[:n] & ~valid[n:2 * n] & valid[2 * n:] & inside)
+    passes = np.flatnonzero(~valid[:n] & ~valid[n : 2 * n] & valid[2 * n :] & inside)
     if len(passes) == 0:
         return None
     k = passes[0]
@@ -262,8 +268,13 @@ def _shortcut(states: list, yaw0: float, problem: _Problem) -> list:
     return [states[k] for k in kept]
 
 
-def path_guide(states, start_yaw: float, field: Heightfield, config: BaselineConfig = BaselineConfig(),
-               reach: ReachabilityConfig = ReachabilityConfig()) -> tuple[np.ndarray, np.ndarray]:
+def path_guide(
+    states,
+    start_yaw: float,
+    field: Heightfield,
+    config: BaselineConfig = BaselineConfig(),
+    reach: ReachabilityConfig = ReachabilityConfig(),
+) -> tuple[np.ndarray, np.ndarray]:
     """Concatenate RBKino paths through planar states into one guide.
 
     Args:
@@ -290,9 +301,16 @@ def path_guide(states, start_yaw: float, field: Heightfield, config: BaselineCon
     return lift_checked(field, np.column_stack([pos, yaw]), config.nominal_root_height, reach)
 
 
-def plan_rrt(field: Heightfield, start, goal, initial_speed: float = 0.0, bounds=None,
-             config: BaselineConfig = BaselineConfig(), rrt: RRTConfig = RRTConfig(),
-             reach: ReachabilityConfig = ReachabilityConfig()) -> RRTResult:
+def plan_rrt(
+    field: Heightfield,
+    start,
+    goal,
+    initial_speed: float = 0.0,
+    bounds=None,
+    config: BaselineConfig = BaselineConfig(),
+    rrt: RRTConfig = RRTConfig(),
+    reach: ReachabilityConfig = ReachabilityConfig(),
+) -> RRTResult:
     """Kinodynamic bidirectional RRT from a start pose to a goal point at rest (host; calls jitted checks).
 
     Args:
@@ -342,8 +360,9 @@ def plan_rrt(field: Heightfield, start, goal, initial_speed: float = 0.0, bounds
             break
     sizes = (len(trees[0].states), len(trees[1].states))
     if found is None:
-        return RRTResult(False, np.zeros((0, 4)), np.zeros((0, 2)), None, iterations, time.monotonic() - began,
-                         sizes)
+        return RRTResult(
+            False, np.zeros((0, 4)), np.zeros((0, 2)), None, iterations, time.monotonic() - began, sizes
+        )
     forward_chain = [trees[0].states[k] for k in trees[0].branch(found[0])]
     backward_chain = [trees[1].states[k] for k in trees[1].branch(found[1])][::-1]
     states = forward_chain + backward_chain
@@ -351,5 +370,6 @@ def plan_rrt(field: Heightfield, start, goal, initial_speed: float = 0.0, bounds
         states = _shortcut(states, yaw0, problem)
     states = np.asarray(states)
     guide, ok = path_guide(states, yaw0, field, config, reach)
-    return RRTResult(bool(ok.all()), states, states[1:, :2].copy(), guide, iterations,
-                     time.monotonic() - began, sizes)
+    return RRTResult(
+        bool(ok.all()), states, states[1:, :2].copy(), guide, iterations, time.monotonic() - began, sizes
+    )

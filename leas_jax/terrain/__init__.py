@@ -1,6 +1,6 @@
 """Terrains: load and validate terrain files, rasterise heightfields, support surfaces, exports.
 
-Host code (NumPy); see docs/architecture.md for the interface and DESIGN §4 for the format.
+Host code (NumPy); see docs/architecture.md for the interface and docs/design.md §4 for the format.
 """
 
 from leas_jax.terrain.loader import load_terrain, loads_terrain

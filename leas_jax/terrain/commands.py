@@ -21,27 +21,38 @@ from leas_jax.terrain.model import Terrain
 
 def register(subparsers) -> None:
     """Add `terrain` with sub-commands generate, show and export to an argparse sub-parser set."""
-    parser = subparsers.add_parser("terrain", help="generate, show and export terrain files",
-                                   description="Generate, show and export terrain files (TOML, format v1).")
+    parser = subparsers.add_parser(
+        "terrain",
+        help="generate, show and export terrain files",
+        description="Generate, show and export terrain files (TOML, format v1).",
+    )
     commands = parser.add_subparsers(dest="terrain_command", metavar="COMMAND", required=True)
 
-    gen = commands.add_parser("generate", help="write the seeded training arena or the evaluation terrains",
-                              description="Write the training arena of a seed (to --out or stdout), "
-                                          "or the evaluation terrains into --eval-dir.")
+    gen = commands.add_parser(
+        "generate",
+        help="write the seeded training arena or the evaluation terrains",
+        description="Write the training arena of a seed (to --out or stdout), "
+        "or the evaluation terrains into --eval-dir.",
+    )
     gen.add_argument("--seed", type=int, default=0, help="arena seed (default 0)")
     gen.add_argument("--out", metavar="FILE", help="output TOML file (default: stdout)")
     gen.add_argument("--eval-dir", metavar="DIR", help="write eval_*.toml into DIR instead of the arena")
     gen.set_defaults(func=cmd_generate)
 
-    show = commands.add_parser("show", help="draw a terrain's heightmap as a PNG",
-                               description="Top-down heightmap with colour bar and the scenario "
-                                           "(start region, target, waypoints).")
+    show = commands.add_parser(
+        "show",
+        help="draw a terrain's heightmap as a PNG",
+        description="Top-down heightmap with colour bar and the scenario (start region, target, waypoints).",
+    )
     show.add_argument("file", metavar="FILE", help="terrain TOML file")
     show.add_argument("--out", metavar="PNG", required=True, help="output image (.png)")
     show.set_defaults(func=cmd_show)
 
-    export = commands.add_parser("export", help="export a terrain to MJCF or a mesh",
-                                 description="Export by extension: .xml (MuJoCo MJCF), .glb, .obj, .stl.")
+    export = commands.add_parser(
+        "export",
+        help="export a terrain to MJCF or a mesh",
+        description="Export by extension: .xml (MuJoCo MJCF), .glb, .obj, .stl.",
+    )
     export.add_argument("file", metavar="FILE", help="terrain TOML file")
     export.add_argument("--out", metavar="PATH", required=True, help="output file (.xml, .glb, .obj, .stl)")
     export.set_defaults(func=cmd_export)
@@ -95,8 +106,10 @@ def cmd_export(args: argparse.Namespace) -> None:
     """Export `args.file` to `args.out` (format by extension)."""
     out = Path(args.out)
     if out.suffix.lower() not in EXPORT_EXTENSIONS:
-        raise UsageError(f"terrain export: --out {args.out}: unknown format "
-                         f"{out.suffix or '(no extension)'!r}, use one of {', '.join(EXPORT_EXTENSIONS)}")
+        raise UsageError(
+            f"terrain export: --out {args.out}: unknown format "
+            f"{out.suffix or '(no extension)'!r}, use one of {', '.join(EXPORT_EXTENSIONS)}"
+        )
     terrain = load_terrain(args.file)
     terrain.export(out)
     print(f"wrote {out}")
@@ -125,23 +138,41 @@ def draw_terrain(terrain: Terrain):
     void = heights <= terrain.void_height
     shown = np.ma.masked_where(void, heights)
     width = 8.0
-    figure, axes = plt.subplots(figsize=(width, max(3.0, width * (ymax - ymin) / (xmax - xmin))),
-                                layout="constrained")
+    figure, axes = plt.subplots(
+        figsize=(width, max(3.0, width * (ymax - ymin) / (xmax - xmin))), layout="constrained"
+    )
     cmap = plt.get_cmap("viridis").with_extremes(bad="#202020")
     # heights[i, j] is at (x_i, y_j): transpose so that rows are y for imshow.
     image = axes.imshow(shown.T, origin="lower", extent=extent, cmap=cmap, interpolation="nearest")
-    figure.colorbar(image, ax=axes, label=f"height (m); void (z = {terrain.void_height:g}) in black",
-                    shrink=0.9)
+    figure.colorbar(
+        image, ax=axes, label=f"height (m); void (z = {terrain.void_height:g}) in black", shrink=0.9
+    )
     scenario = terrain.scenario
     if scenario is not None:
         (rx0, ry0), (rx1, ry1) = scenario.start_region
-        axes.add_patch(Rectangle((rx0, ry0), rx1 - rx0, ry1 - ry0, fill=False, edgecolor="red",
-                                 linestyle="--", linewidth=1.5, label="start region"))
+        axes.add_patch(
+            Rectangle(
+                (rx0, ry0),
+                rx1 - rx0,
+                ry1 - ry0,
+                fill=False,
+                edgecolor="red",
+                linestyle="--",
+                linewidth=1.5,
+                label="start region",
+            )
+        )
         route = [np.mean(scenario.start_region, axis=0)]
         if scenario.waypoints is not None:
             route += list(scenario.waypoints)
-            axes.plot(scenario.waypoints[:, 0], scenario.waypoints[:, 1], "o", color="gold",
-                      markeredgecolor="black", label="waypoints")
+            axes.plot(
+                scenario.waypoints[:, 0],
+                scenario.waypoints[:, 1],
+                "o",
+                color="gold",
+                markeredgecolor="black",
+                label="waypoints",
+            )
             for k, (wx, wy) in enumerate(scenario.waypoints):
                 axes.annotate(str(k + 1), (wx, wy), textcoords="offset points", xytext=(4, 4), fontsize=8)
         route.append(scenario.target)

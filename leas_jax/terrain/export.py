@@ -54,8 +54,10 @@ def terrain_to_mjcf(terrain: Terrain) -> str:
         f'    <light pos="{_fmt([(xmin + xmax) / 2, (ymin + ymax) / 2, 10.0])}" dir="0 0 -1" directional="true"/>',
     ]
     for index, box in enumerate(terrain.boxes):
-        lines.append(f'    <geom name="box{index}" type="box" pos="{_fmt(box.center)}" '
-                     f'size="{_fmt(box.half)}" quat="{_fmt(box.quaternion_wxyz)}"/>')
+        lines.append(
+            f'    <geom name="box{index}" type="box" pos="{_fmt(box.center)}" '
+            f'size="{_fmt(box.half)}" quat="{_fmt(box.quaternion_wxyz)}"/>'
+        )
     lines += ["  </worldbody>", "</mujoco>", ""]
     return "\n".join(lines)
 
@@ -86,8 +88,9 @@ def export_terrain(terrain: Terrain, path) -> None:
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in EXPORT_EXTENSIONS:
-        raise TerrainError(f"{path}: unknown export format {suffix or '(none)'!r}: "
-                           f"use one of {', '.join(EXPORT_EXTENSIONS)}")
+        raise TerrainError(
+            f"{path}: unknown export format {suffix or '(none)'!r}: use one of {', '.join(EXPORT_EXTENSIONS)}"
+        )
     try:
         if suffix == ".xml":
             path.write_text(terrain_to_mjcf(terrain), encoding="utf-8")

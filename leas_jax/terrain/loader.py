@@ -1,4 +1,4 @@
-"""Read and validate terrain files (TOML, DESIGN §4 terrain format v1).
+"""Read and validate terrain files (TOML, docs/design.md §4 terrain format v1).
 
 Every rejection is a TerrainError with one line naming the file, the key and the value:
 `terrains/x.toml: box[3].size = [1.0, 0.0, 0.2]: every element must be > 0`.
@@ -8,14 +8,14 @@ Boxes are numbered from 0 in file order.
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 
 import numpy as np
+import tomllib
 
 from leas_jax.terrain.model import Box, Scenario, Terrain, TerrainError, raster_shape
 
-MAX_CELLS = 50_000_000  # DESIGN §4: larger heightfields are rejected
+MAX_CELLS = 50_000_000  # docs/design.md §4: larger heightfields are rejected
 
 TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario"}
 TOP_REQUIRED = ("name", "bounds", "void_height", "resolution", "box")
@@ -51,7 +51,7 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
     """Parse and validate terrain TOML text.
 
     Args:
-        text: TOML text (DESIGN §4).
+        text: TOML text (docs/design.md §4).
         source: name used in error messages (usually the file path).
         path: stored as `Terrain.path`.
 
@@ -82,9 +82,12 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
         check.fail("resolution", data["resolution"], "must be > 0")
     nx, ny = raster_shape(bounds, resolution)
     if nx * ny > MAX_CELLS:
-        check.fail("resolution", data["resolution"],
-                   f"heightfield of {nx} x {ny} = {nx * ny} cells over bounds {data['bounds']} "
-                   f"exceeds {MAX_CELLS} cells")
+        check.fail(
+            "resolution",
+            data["resolution"],
+            f"heightfield of {nx} x {ny} = {nx * ny} cells over bounds {data['bounds']} "
+            f"exceeds {MAX_CELLS} cells",
+        )
 
     raw_boxes = data["box"]
     if not isinstance(raw_boxes, list) or not all(isinstance(b, dict) for b in raw_boxes):
@@ -96,8 +99,16 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
     scenario = None
     if "scenario" in data:
         scenario = _scenario(check, data["scenario"], bounds)
-    return Terrain(name=name, bounds=bounds, void_height=void_height, resolution=resolution,
-                   boxes=boxes, scenario=scenario, text=text, path=path)
+    return Terrain(
+        name=name,
+        bounds=bounds,
+        void_height=void_height,
+        resolution=resolution,
+        boxes=boxes,
+        scenario=scenario,
+        text=text,
+        path=path,
+    )
 
 
 def _box(check: _Checker, key: str, raw: dict) -> Box:
@@ -120,12 +131,16 @@ def _scenario(check: _Checker, raw, bounds: np.ndarray) -> Scenario:
     region = check.array("scenario.start_region", raw["start_region"], (2, 2))
     yaw = check.array("scenario.start_yaw_deg", raw["start_yaw_deg"], (2,))
     speed = check.array("scenario.start_speed", raw["start_speed"], (2,))
-    for key, pair, what in (("scenario.start_region", region[:, 0], "x"),
-                            ("scenario.start_region", region[:, 1], "y"),
-                            ("scenario.start_yaw_deg", yaw, "value"),
-                            ("scenario.start_speed", speed, "value")):
+    for key, pair, what in (
+        ("scenario.start_region", region[:, 0], "x"),
+        ("scenario.start_region", region[:, 1], "y"),
+        ("scenario.start_yaw_deg", yaw, "value"),
+        ("scenario.start_speed", speed, "value"),
+    ):
         if pair[0] > pair[1]:
-            check.fail(key, raw[key.split(".")[1]], f"minimum {what} ({pair[0]}) must be <= maximum ({pair[1]})")
+            check.fail(
+                key, raw[key.split(".")[1]], f"minimum {what} ({pair[0]}) must be <= maximum ({pair[1]})"
+            )
     if speed[0] < 0.0:
         check.fail("scenario.start_speed", raw["start_speed"], "speeds must be >= 0")
     n_starts = check.integer("scenario.n_starts", raw["n_starts"])
@@ -139,15 +154,24 @@ def _scenario(check: _Checker, raw, bounds: np.ndarray) -> Scenario:
         waypoints = check.array("scenario.waypoints", raw["waypoints"], (-1, 2))
         if len(waypoints) == 0:
             check.fail("scenario.waypoints", raw["waypoints"], "must hold at least one [x, y] point")
-    points = [("scenario.target", raw["target"], target[None]),
-              ("scenario.start_region", raw["start_region"], region)]
+    points = [
+        ("scenario.target", raw["target"], target[None]),
+        ("scenario.start_region", raw["start_region"], region),
+    ]
     if waypoints is not None:
         points.append(("scenario.waypoints", raw["waypoints"], waypoints))
     for key, value, xy in points:
         if np.any(xy < bounds[0]) or np.any(xy > bounds[1]):
             check.fail(key, value, f"lies outside the terrain bounds {bounds.tolist()}")
-    return Scenario(target=target, start_region=region, start_yaw_deg=yaw, start_speed=speed,
-                    n_starts=n_starts, seed=seed, waypoints=waypoints)
+    return Scenario(
+        target=target,
+        start_region=region,
+        start_yaw_deg=yaw,
+        start_speed=speed,
+        n_starts=n_starts,
+        seed=seed,
+        waypoints=waypoints,
+    )
 
 
 class _Checker:
@@ -188,6 +212,7 @@ class _Checker:
 
     def array(self, key: str, value, shape: tuple[int, ...]) -> np.ndarray:
         """A nested array of finite numbers of the given shape (-1: any length >= 0)."""
+
         def walk(item, dims, index):
             if not dims:
                 if isinstance(item, bool) or not isinstance(item, (int, float)):

@@ -1,6 +1,6 @@
 """Terrain data model: boxes over a void, their heightfield, support surfaces and exports.
 
-Host code (NumPy); nothing here can be jitted. The file format is DESIGN §4 (terrain
+Host code (NumPy); nothing here can be jitted. The file format is docs/design.md §4 (terrain
 format v1); the interface is docs/architecture.md. All coordinates are world frame,
 metres, z up.
 """
@@ -70,12 +70,14 @@ def quaternion_wxyz_from_rpy(rpy) -> np.ndarray:
     cp, sp = math.cos(pitch), math.sin(pitch)
     cy, sy = math.cos(yaw), math.sin(yaw)
     # q = qz(yaw) * qy(pitch) * qx(roll), expanded.
-    q = np.array([
-        cy * cp * cr + sy * sp * sr,
-        cy * cp * sr - sy * sp * cr,
-        cy * sp * cr + sy * cp * sr,
-        sy * cp * cr - cy * sp * sr,
-    ])
+    q = np.array(
+        [
+            cy * cp * cr + sy * sp * sr,
+            cy * cp * sr - sy * sp * cr,
+            cy * sp * cr + sy * cp * sr,
+            sy * cp * cr - cy * sp * sr,
+        ]
+    )
     return q if q[0] >= 0.0 else -q
 
 
@@ -101,8 +103,11 @@ class Box:
     def __eq__(self, other):
         if not isinstance(other, Box):
             return NotImplemented
-        return (np.array_equal(self.center, other.center) and np.array_equal(self.size, other.size)
-                and np.array_equal(self.rpy, other.rpy))
+        return (
+            np.array_equal(self.center, other.center)
+            and np.array_equal(self.size, other.size)
+            and np.array_equal(self.rpy, other.rpy)
+        )
 
     def __hash__(self):
         return hash((self.center.tobytes(), self.size.tobytes(), self.rpy.tobytes()))
@@ -185,7 +190,7 @@ class Box:
 
 @dataclass(frozen=True, eq=False)
 class Scenario:
-    """Evaluation scenario of a terrain (DESIGN §4 `[scenario]`).
+    """Evaluation scenario of a terrain (docs/design.md §4 `[scenario]`).
 
     Attributes:
         target: [2] goal (x, y), world frame, m; z comes from the terrain.
@@ -255,13 +260,15 @@ def face_polygon(box: Box, axis: int, sign: int) -> tuple[np.ndarray, np.ndarray
     u, v = rot[:, i], sign * rot[:, j]
     hu, hv = box.half[i], box.half[j]
     centre = box.center + normal * box.half[axis]
-    corners = np.array([centre + su * hu * u + sv * hv * v for su, sv in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
+    corners = np.array(
+        [centre + su * hu * u + sv * hv * v for su, sv in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+    )
     return corners, normal
 
 
 @dataclass(frozen=True, eq=False)
 class Terrain:
-    """A terrain: a union of boxes over a void (DESIGN §4).
+    """A terrain: a union of boxes over a void (docs/design.md §4).
 
     Attributes:
         name: terrain name.
@@ -303,8 +310,10 @@ class Terrain:
     def grid_axes(self) -> tuple[np.ndarray, np.ndarray]:
         """Raster coordinates: ([nx] x = xmin + i*res, [ny] y = ymin + j*res), world, m."""
         nx, ny = self.shape
-        return (self.bounds[0, 0] + np.arange(nx) * self.resolution,
-                self.bounds[0, 1] + np.arange(ny) * self.resolution)
+        return (
+            self.bounds[0, 0] + np.arange(nx) * self.resolution,
+            self.bounds[0, 1] + np.arange(ny) * self.resolution,
+        )
 
     def raster(self) -> np.ndarray:
         """Heightfield of the terrain (cached, read-only).
@@ -379,8 +388,11 @@ class Terrain:
         buried = np.zeros(len(faces), dtype=bool)
         for index, box in enumerate(self.boxes):
             buried |= box.contains(probes) & (owner != index)
-        surfaces = [SupportSurface(corners, normal, index)
-                    for (index, corners, normal), hidden in zip(faces, buried) if not hidden]
+        surfaces = [
+            SupportSurface(corners, normal, index)
+            for (index, corners, normal), hidden in zip(faces, buried)
+            if not hidden
+        ]
         return surfaces
 
     def to_mjcf(self) -> str:
@@ -477,6 +489,5 @@ def rasterize(boxes, bounds, resolution: float, void_height: float) -> np.ndarra
             b = min(a + rows, i1 + 1)
             xs = bounds[0, 0] + np.arange(a, b) * resolution
             column = box.column_top(xs[:, None], ys[None, :])
-            np.maximum(top[a:b, j0:j1 + 1], column, out=top[a:b, j0:j1 + 1])
+            np.maximum(top[a:b, j0 : j1 + 1], column, out=top[a:b, j0 : j1 + 1])
     return np.where(np.isfinite(top), top, void_height).astype(np.float32)
-

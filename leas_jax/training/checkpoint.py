@@ -80,8 +80,13 @@ def load_state(path: Path):
 
 def save_policy(run_dir: Path, normalizer, policy_params, config_dict: dict, env_steps: int) -> Path:
     """Write `policy.pkl`: everything `load_policy` needs, nothing more."""
-    payload = {"format": "leas-policy-v1", "config": config_dict, "env_steps": int(env_steps),
-               "normalizer": to_host(normalizer), "policy_params": to_host(policy_params)}
+    payload = {
+        "format": "leas-policy-v1",
+        "config": config_dict,
+        "env_steps": int(env_steps),
+        "normalizer": to_host(normalizer),
+        "policy_params": to_host(policy_params),
+    }
     path = Path(run_dir) / "policy.pkl"
     atomic_write_bytes(path, pickle.dumps(payload, protocol=pickle.HIGHEST_PROTOCOL))
     return path

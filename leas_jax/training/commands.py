@@ -23,33 +23,63 @@ def _add_training_arguments(parser) -> None:
     from leas_jax.cli import add_ray_address_argument
     from leas_jax.training.config import PRESETS
 
-    parser.add_argument("--preset", default="quick", choices=sorted(PRESETS),
-                        help="geometric: smoke (< 1 min), quick (80 M steps, 3 epochs, clearance reward term, "
-                             "~6 min on 2 cores), paper (80 M steps, 10 epochs, the paper's reward, ~25 min); "
-                             "planner: smoke (20 k kept steps from scratch), quick and paper (the geometric preset of the same name in "
-                             "<out>/pretrain, then 150 k / 600 k kept steps with the planner)")
-    parser.add_argument("--mode", default="geometric", choices=["geometric", "planner"],
-                        help="geometric: reachability condition only; planner: every episode validated by the "
-                             "Talos contact generator (the paper's method)")
-    parser.add_argument("--init", metavar="RUN_DIR", default=None,
-                        help="planner mode: fine-tune from this geometric run's latest checkpoint "
-                             "(instead of the preset's own pretraining)")
-    parser.add_argument("--workers", type=int, default=None,
-                        help="planner mode: contact-generator worker processes (default: one per CPU; "
-                             "0 plans in this process)")
+    parser.add_argument(
+        "--preset",
+        default="quick",
+        choices=sorted(PRESETS),
+        help="geometric: smoke (< 1 min), quick (80 M steps, 3 epochs, clearance reward term, "
+        "~6 min on 2 cores), paper (80 M steps, 10 epochs, the paper's reward, ~25 min); "
+        "planner: smoke (20 k kept steps from scratch), quick and paper (the geometric preset of the same name in "
+        "<out>/pretrain, then 150 k / 600 k kept steps with the planner)",
+    )
+    parser.add_argument(
+        "--mode",
+        default="geometric",
+        choices=["geometric", "planner"],
+        help="geometric: reachability condition only; planner: every episode validated by the "
+        "Talos contact generator (the paper's method)",
+    )
+    parser.add_argument(
+        "--init",
+        metavar="RUN_DIR",
+        default=None,
+        help="planner mode: fine-tune from this geometric run's latest checkpoint "
+        "(instead of the preset's own pretraining)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="planner mode: contact-generator worker processes (default: one per CPU; "
+        "0 plans in this process)",
+    )
     add_ray_address_argument(parser, "planner mode: validate the guides")
-    parser.add_argument("--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)")
+    parser.add_argument(
+        "--out", required=True, metavar="DIR", help="run directory (resumes if it holds a checkpoint)"
+    )
     parser.add_argument("--seed", type=int, default=None, help="PRNG seed (default: the preset's, 0)")
-    parser.add_argument("--terrain", metavar="FILE", default=None,
-                        help="training terrain (default terrains/training_arena.toml)")
-    parser.add_argument("--timesteps", type=_positive_int, default=None, help="override the preset's env steps")
-    parser.add_argument("--num-envs", type=_positive_int, default=None, help="override the number of parallel envs")
-    parser.add_argument("--reachability", choices=["presets", "calibrated"], default="presets",
-                        help="condition the policy trains with (both phases): presets (the default: "
-                             "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
-                             "lookahead legs, foothold and gripper disks, 95.5 / 90.2 %% sensitivity / specificity "
-                             "against the walking generator on fresh poses; the README's \"Contact generator\" "
-                             "gives the trade)")
+    parser.add_argument(
+        "--terrain",
+        metavar="FILE",
+        default=None,
+        help="training terrain (default terrains/training_arena.toml)",
+    )
+    parser.add_argument(
+        "--timesteps", type=_positive_int, default=None, help="override the preset's env steps"
+    )
+    parser.add_argument(
+        "--num-envs", type=_positive_int, default=None, help="override the number of parallel envs"
+    )
+    parser.add_argument(
+        "--reachability",
+        choices=["presets", "calibrated"],
+        default="presets",
+        help="condition the policy trains with (both phases): presets (the default: "
+        "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
+        "lookahead legs, foothold and gripper disks, 95.5 / 90.2 %% sensitivity / specificity "
+        'against the walking generator on fresh poses; the README\'s "Contact generator" '
+        "gives the trade)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -80,7 +110,9 @@ def config_from_args(args):
     if args.reachability == "calibrated":
         from leas_jax.env import ReachabilityConfig
 
-        config = dataclasses.replace(config, env=dataclasses.replace(config.env, reachability=ReachabilityConfig()))
+        config = dataclasses.replace(
+            config, env=dataclasses.replace(config.env, reachability=ReachabilityConfig())
+        )
     return config
 
 
@@ -88,10 +120,14 @@ def cmd_train(args) -> int:
     from leas_jax.training.loop import train
 
     config = config_from_args(args)
-    result = train(config, args.out, progress=not args.no_progress, workers=args.workers, address=args.ray_address)
+    result = train(
+        config, args.out, progress=not args.no_progress, workers=args.workers, address=args.ray_address
+    )
     metrics = result.metrics
-    print(f"trained {result.env_steps:,} env steps in {result.wall_s:.0f} s "
-          f"({metrics.get('sps', float('nan')):,.0f} steps/s); policy: {result.policy_path}")
+    print(
+        f"trained {result.env_steps:,} env steps in {result.wall_s:.0f} s "
+        f"({metrics.get('sps', float('nan')):,.0f} steps/s); policy: {result.policy_path}"
+    )
     return 0
 
 
@@ -107,38 +143,75 @@ def cmd_run(args) -> int:
     geometric = config_from_args(args)
     train(geometric, out / "geometric", progress=not args.no_progress)
     if args.planner_steps > 0:
-        overrides = {"num_timesteps": args.planner_steps, "init_from": str(out / "geometric"),
-                     "terrain": geometric.terrain, "seed": geometric.seed, "env": geometric.env}
-        train(preset(args.preset, mode="planner", **overrides), out / "planner", progress=not args.no_progress,
-              workers=args.workers, address=args.ray_address)
+        overrides = {
+            "num_timesteps": args.planner_steps,
+            "init_from": str(out / "geometric"),
+            "terrain": geometric.terrain,
+            "seed": geometric.seed,
+            "env": geometric.env,
+        }
+        train(
+            preset(args.preset, mode="planner", **overrides),
+            out / "planner",
+            progress=not args.no_progress,
+            workers=args.workers,
+            address=args.ray_address,
+        )
     workers = 2 if args.workers is None else args.workers
-    report = write_report(out, n_episodes=args.eval_episodes, compare_starts=args.compare_starts,
-                          baseline_starts=args.baseline_starts, workers=workers)
+    report = write_report(
+        out,
+        n_episodes=args.eval_episodes,
+        compare_starts=args.compare_starts,
+        baseline_starts=args.baseline_starts,
+        workers=workers,
+    )
     print(f"report: {report}")
     return 0
 
 
 def register(subparsers) -> None:
-    train = subparsers.add_parser("train", help="train a LeaS policy (geometric PPO)",
-                                  description="Train a LeaS policy with Brax PPO on the training arena. "
-                                              "Writes config.json, checkpoints/, policy.pkl, metrics.jsonl "
-                                              "and tb/ into --out; an interrupted run resumes from its last "
-                                              "checkpoint when started again with the same --out.")
+    train = subparsers.add_parser(
+        "train",
+        help="train a LeaS policy (geometric PPO)",
+        description="Train a LeaS policy with Brax PPO on the training arena. "
+        "Writes config.json, checkpoints/, policy.pkl, metrics.jsonl "
+        "and tb/ into --out; an interrupted run resumes from its last "
+        "checkpoint when started again with the same --out.",
+    )
     _add_training_arguments(train)
     train.set_defaults(func=cmd_train)
 
-    run = subparsers.add_parser("run", help="the main job: train, fine-tune with the planner, evaluate",
-                                description="Geometric training (<out>/geometric), planner-in-the-loop "
-                                            "fine-tuning (<out>/planner), then <out>/report.md: learning "
-                                            "curves, rollouts, coverage before/after, Table II against the "
-                                            "baselines. Each phase resumes if interrupted.")
+    run = subparsers.add_parser(
+        "run",
+        help="the main job: train, fine-tune with the planner, evaluate",
+        description="Geometric training (<out>/geometric), planner-in-the-loop "
+        "fine-tuning (<out>/planner), then <out>/report.md: learning "
+        "curves, rollouts, coverage before/after, Table II against the "
+        "baselines. Each phase resumes if interrupted.",
+    )
     _add_training_arguments(run)
-    run.add_argument("--eval-episodes", type=_positive_int, default=256,
-                     help="episodes per geometric evaluation metric (default 256)")
-    run.add_argument("--planner-steps", type=int, default=150_000,
-                     help="kept env steps of planner-in-the-loop fine-tuning (default 150 000; 0 skips it; see docs/results for 500 000)")
-    run.add_argument("--compare-starts", type=_positive_int, default=24,
-                     help="starts per terrain for the before/after coverage comparison (default 24)")
-    run.add_argument("--baseline-starts", type=_positive_int, default=10,
-                     help="trajectories per Table II cell in the report (default 10; the paper: 60)")
+    run.add_argument(
+        "--eval-episodes",
+        type=_positive_int,
+        default=256,
+        help="episodes per geometric evaluation metric (default 256)",
+    )
+    run.add_argument(
+        "--planner-steps",
+        type=int,
+        default=150_000,
+        help="kept env steps of planner-in-the-loop fine-tuning (default 150 000; 0 skips it; see docs/results for 500 000)",
+    )
+    run.add_argument(
+        "--compare-starts",
+        type=_positive_int,
+        default=24,
+        help="starts per terrain for the before/after coverage comparison (default 24)",
+    )
+    run.add_argument(
+        "--baseline-starts",
+        type=_positive_int,
+        default=10,
+        help="trajectories per Table II cell in the report (default 10; the paper: 60)",
+    )
     run.set_defaults(func=cmd_run)

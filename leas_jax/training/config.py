@@ -98,7 +98,9 @@ class TrainConfig:
     iterations_per_call: int = 4  # iterations fused into one compiled call (fewer host round trips)
     checkpoint_every_s: float = 60.0  # wall-clock seconds between checkpoints
     keep_checkpoints: int = 3
-    env: EnvConfig = field(default_factory=lambda: TRAINING_ENV)  # the presets' condition, see TRAINING_REACHABILITY
+    env: EnvConfig = field(
+        default_factory=lambda: TRAINING_ENV
+    )  # the presets' condition, see TRAINING_REACHABILITY
 
     def terrain_path(self) -> Path:
         """The training terrain file: as given, else relative to the repository root."""
@@ -115,10 +117,18 @@ class TrainConfig:
         per_call = self.batch_size * self.iterations_per_call
         return max(1, -(-self.num_timesteps // per_call)) * self.iterations_per_call
 
-    def validate(self) -> "TrainConfig":
+    def validate(self) -> TrainConfig:
         """Raise UsageError naming the first bad field."""
-        positive = ["num_timesteps", "num_envs", "unroll_length", "num_minibatches", "num_epochs",
-                    "learning_rate", "iterations_per_call", "keep_checkpoints"]
+        positive = [
+            "num_timesteps",
+            "num_envs",
+            "unroll_length",
+            "num_minibatches",
+            "num_epochs",
+            "learning_rate",
+            "iterations_per_call",
+            "keep_checkpoints",
+        ]
         for name in positive:
             if not getattr(self, name) > 0:
                 raise UsageError(f"TrainConfig.{name} must be > 0, got {getattr(self, name)!r}")
@@ -127,14 +137,20 @@ class TrainConfig:
         if self.mode not in ("geometric", "planner"):
             raise UsageError(f"TrainConfig.mode must be 'geometric' or 'planner', got {self.mode!r}")
         if self.learning_rate_schedule not in ("linear", "constant"):
-            raise UsageError(f"TrainConfig.learning_rate_schedule must be 'linear' or 'constant', "
-                             f"got {self.learning_rate_schedule!r}")
+            raise UsageError(
+                f"TrainConfig.learning_rate_schedule must be 'linear' or 'constant', "
+                f"got {self.learning_rate_schedule!r}"
+            )
         if self.pretrain and self.pretrain not in PRESETS:
-            raise UsageError(f"TrainConfig.pretrain must be '' or a geometric preset ({', '.join(PRESETS)}), "
-                             f"got {self.pretrain!r}")
+            raise UsageError(
+                f"TrainConfig.pretrain must be '' or a geometric preset ({', '.join(PRESETS)}), "
+                f"got {self.pretrain!r}"
+            )
         if self.num_envs % self.num_minibatches:
-            raise UsageError(f"TrainConfig.num_envs ({self.num_envs}) must be a multiple of "
-                             f"num_minibatches ({self.num_minibatches})")
+            raise UsageError(
+                f"TrainConfig.num_envs ({self.num_envs}) must be a multiple of "
+                f"num_minibatches ({self.num_minibatches})"
+            )
         return self
 
     def to_dict(self) -> dict:
@@ -144,7 +160,7 @@ class TrainConfig:
         return json.dumps(self.to_dict(), indent=2, sort_keys=True)
 
     @staticmethod
-    def from_dict(data: dict) -> "TrainConfig":
+    def from_dict(data: dict) -> TrainConfig:
         """Inverse of `to_dict`; unknown keys raise UsageError naming them."""
         data = dict(data)
         env = dict(data.pop("env", {}))
@@ -174,8 +190,14 @@ QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.
 
 PRESETS = {
     # under a minute on 2 cores, compile included: checks that everything runs
-    "smoke": dict(num_timesteps=400_000, num_envs=512, unroll_length=16, num_minibatches=4,
-                  num_epochs=4, iterations_per_call=4),
+    "smoke": dict(
+        num_timesteps=400_000,
+        num_envs=512,
+        unroll_length=16,
+        num_minibatches=4,
+        num_epochs=4,
+        iterations_per_call=4,
+    ),
     # the paper's 80 M-step budget in about 7 minutes on 2 cores: 3 epochs of 8
     # mini-batches (benchmarks/train_throughput.py: 176-185 k env steps/s here at load 1.5)
     "quick": dict(num_timesteps=80_000_000, num_epochs=3, num_minibatches=8, env=QUICK_ENV),
@@ -197,8 +219,9 @@ PRESETS = {
 # (docs/results/make-run-2026-11-22-planner-500k).
 PLANNER_PRESETS = {
     "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
-    "quick": dict(num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick",
-                  env=QUICK_ENV),
+    "quick": dict(
+        num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick", env=QUICK_ENV
+    ),
     "paper": dict(num_timesteps=600_000, num_envs=64, num_minibatches=4, num_epochs=10, pretrain="paper"),
 }
 

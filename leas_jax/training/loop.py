@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Optional
 
 import jax
 import numpy as np
@@ -43,15 +43,25 @@ def _check_config(run_dir: Path, config: TrainConfig) -> None:
     current = json.loads(config.to_json())
     diff = sorted(k for k in set(saved) | set(current) if saved.get(k) != current.get(k))
     if diff:
-        raise UsageError(f"{path}: run directory holds a run with a different config "
-                         f"(differs in {', '.join(diff)}); use another --out or the same settings")
+        raise UsageError(
+            f"{path}: run directory holds a run with a different config "
+            f"(differs in {', '.join(diff)}); use another --out or the same settings"
+        )
 
 
 class RunLog:
     """metrics.jsonl + TensorBoard + tqdm bar + periodic atomic checkpoints of one run."""
 
-    def __init__(self, run_dir: Path, config: TrainConfig, state: TrainState, resumed: bool, progress: bool,
-                 total_steps: int, on_log: Optional[Callable[[dict], None]]):
+    def __init__(
+        self,
+        run_dir: Path,
+        config: TrainConfig,
+        state: TrainState,
+        resumed: bool,
+        progress: bool,
+        total_steps: int,
+        on_log: Callable[[dict], None] | None,
+    ):
         from tensorboardX import SummaryWriter
         from tqdm.auto import tqdm
 
@@ -60,8 +70,14 @@ class RunLog:
         lines = self.path.read_text().splitlines() if (resumed and self.path.exists()) else []
         self.wall_before = float(json.loads(lines[-1])["wall_s"]) if lines else 0.0
         self.writer = SummaryWriter(str(run_dir / "tb"))
-        self.bar = tqdm(total=total_steps, initial=min(int(state.env_steps), total_steps), unit="step",
-                        unit_scale=True, disable=not progress, desc=f"train {config.mode} {config.preset}")
+        self.bar = tqdm(
+            total=total_steps,
+            initial=min(int(state.env_steps), total_steps),
+            unit="step",
+            unit_scale=True,
+            disable=not progress,
+            desc=f"train {config.mode} {config.preset}",
+        )
         self.t_start = self.last_ckpt = time.perf_counter()
         self.record: dict = {}
 
@@ -86,7 +102,9 @@ class RunLog:
     def checkpoint(self, state: TrainState) -> None:
         steps = int(state.env_steps)
         checkpoint.save_state(self.run_dir, state, steps, self.config.keep_checkpoints)
-        checkpoint.save_policy(self.run_dir, state.normalizer, state.params.policy, self.config.to_dict(), steps)
+        checkpoint.save_policy(
+            self.run_dir, state.normalizer, state.params.policy, self.config.to_dict(), steps
+        )
         self.last_ckpt = time.perf_counter()
 
     def close(self) -> None:
@@ -98,11 +116,16 @@ def _summarise(raw: dict, env_steps: int, iteration: int, sps: float) -> dict:
     """Per-call geometric metrics -> JSON-friendly log record."""
     raw = {k: float(v) for k, v in raw.items()}
     episodes = raw.pop("episodes")
-    ret, length, invalid = (raw.pop(k) for k in ("episode_return_sum", "episode_length_sum", "invalid_episodes"))
+    ret, length, invalid = (
+        raw.pop(k) for k in ("episode_return_sum", "episode_length_sum", "invalid_episodes")
+    )
     record = {"iteration": iteration, "env_steps": env_steps, "sps": round(sps, 1), "episodes": int(episodes)}
     if episodes > 0:
-        record.update(episode_return=ret / episodes, episode_length=length / episodes,
-                      invalid_fraction=invalid / episodes)
+        record.update(
+            episode_return=ret / episodes,
+            episode_length=length / episodes,
+            invalid_fraction=invalid / episodes,
+        )
     record.update(raw)
     return record
 
@@ -116,10 +139,17 @@ def initial_params_from(run_dir: str | Path):
     return state.params, state.normalizer
 
 
-def train(config: TrainConfig, out: str | Path, progress: bool = True,
-          on_log: Optional[Callable[[dict], None]] = None, stop_after_iterations: Optional[int] = None,
-          field=None, workers: Optional[int] = None, address: Optional[str] = None,
-          pool_options: Optional[dict] = None) -> TrainResult:
+def train(
+    config: TrainConfig,
+    out: str | Path,
+    progress: bool = True,
+    on_log: Callable[[dict], None] | None = None,
+    stop_after_iterations: int | None = None,
+    field=None,
+    workers: int | None = None,
+    address: str | None = None,
+    pool_options: dict | None = None,
+) -> TrainResult:
     """Train a LeaS policy; resume if `out` holds a checkpoint.
 
     Args:
@@ -136,7 +166,7 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
         workers: planner mode: contact-generator worker processes (None: one
             per CPU; 0: in this process).
         address: planner mode: a validation backend address (e.g. a Ray
-            cluster, see `leas_jax.contacts.pool.register_backend`).
+            cluster, see `leas_jax.contacts.validation.pool.register_backend`).
         pool_options: planner mode: more `ValidationPool` keyword arguments
             (task_timeout, max_attempts, plan_fn for fault-injection tests).
 
@@ -168,23 +198,37 @@ def train(config: TrainConfig, out: str | Path, progress: bool = True,
         state = jax.tree.map(jax.numpy.asarray, checkpoint.load_state(found[-1][1]))
     elif init_from:
         params, normalizer = initial_params_from(init_from)
-        state = state.replace(params=jax.tree.map(jax.numpy.asarray, params),
-                              normalizer=jax.tree.map(jax.numpy.asarray, normalizer))
+        state = state.replace(
+            params=jax.tree.map(jax.numpy.asarray, params),
+            normalizer=jax.tree.map(jax.numpy.asarray, normalizer),
+        )
     total = config.num_timesteps if config.mode == "planner" else config.num_iterations * config.batch_size
     log = RunLog(run_dir, config, state, bool(found), progress, total, on_log)
     run = _planner_iterations if config.mode == "planner" else _geometric_iterations
     t_start = time.perf_counter()
     try:
-        state = run(config, state, field, terrain, log, stop_after_iterations,
-                    dict(workers=workers, address=address, **(pool_options or {})))
+        state = run(
+            config,
+            state,
+            field,
+            terrain,
+            log,
+            stop_after_iterations,
+            dict(workers=workers, address=address, **(pool_options or {})),
+        )
     except KeyboardInterrupt:
         log.checkpoint(state)
         log.close()
         raise
     log.checkpoint(state)
     log.close()
-    return TrainResult(run_dir=run_dir, policy_path=run_dir / "policy.pkl", env_steps=int(state.env_steps),
-                       wall_s=time.perf_counter() - t_start, metrics=log.record)
+    return TrainResult(
+        run_dir=run_dir,
+        policy_path=run_dir / "policy.pkl",
+        env_steps=int(state.env_steps),
+        wall_s=time.perf_counter() - t_start,
+        metrics=log.record,
+    )
 
 
 def _geometric_iterations(config, state, field, terrain, log: RunLog, stop_after, pool_options) -> TrainState:
@@ -197,8 +241,12 @@ def _geometric_iterations(config, state, field, terrain, log: RunLog, stop_after
         t0 = time.perf_counter()
         state, raw = call(state, field)
         raw = jax.device_get(raw)
-        log.log(_summarise(raw, int(state.env_steps), int(state.iteration), per_call / (time.perf_counter() - t0)),
-                per_call)
+        log.log(
+            _summarise(
+                raw, int(state.env_steps), int(state.iteration), per_call / (time.perf_counter() - t0)
+            ),
+            per_call,
+        )
         log.maybe_checkpoint(state)
     return state
 
@@ -209,7 +257,7 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
     A batch in flight when the run stops is dropped (it is re-drawn on
     resume from the saved PRNG key); only updated states are checkpointed.
     """
-    from leas_jax.contacts.pool import ValidationPool, available_cpus
+    from leas_jax.contacts.validation.pool import ValidationPool, available_cpus
     from leas_jax.training.planner import guides_of, make_planner_fns
 
     rollout, update = make_planner_fns(config)
@@ -243,10 +291,14 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
             state = state.replace(key=next_state.key)
             episodes, future, k_update = next_episodes, next_future, next_k_update
             elapsed = time.perf_counter() - t0
-            record.update(iteration=int(state.iteration), env_steps=int(state.env_steps),
-                          sps=round(record["kept_steps"] / elapsed, 1),
-                          rolled_sps=round(record["rolled_steps"] / elapsed, 1),
-                          validation_wait_s=round(wait_s, 3), wait_fraction=round(wait_s / elapsed, 3))
+            record.update(
+                iteration=int(state.iteration),
+                env_steps=int(state.env_steps),
+                sps=round(record["kept_steps"] / elapsed, 1),
+                rolled_sps=round(record["rolled_steps"] / elapsed, 1),
+                validation_wait_s=round(wait_s, 3),
+                wait_fraction=round(wait_s / elapsed, 3),
+            )
             log.log(record, int(record["kept_steps"]))
             log.maybe_checkpoint(state)
     finally:
@@ -271,7 +323,11 @@ def _apply_validated_batch(state, episodes, results, key, update):
     coverage = np.array([r.coverage for r in results])
     batch, stats = training_batch(episodes, last_valid)
     state, losses = update(state, batch, key)
-    record = {**stats, "mean_coverage": float(coverage.mean()), "full_coverage_fraction": float((coverage >= 1.0).mean()),
-              "generator_errors": len(errors),
-              **{k: float(v) for k, v in jax.device_get(losses).items()}}
+    record = {
+        **stats,
+        "mean_coverage": float(coverage.mean()),
+        "full_coverage_fraction": float((coverage >= 1.0).mean()),
+        "generator_errors": len(errors),
+        **{k: float(v) for k, v in jax.device_get(losses).items()},
+    }
     return state, record

@@ -1,4 +1,4 @@
-"""Planner-in-the-loop PPO, the paper's method (DESIGN.md §7), jitted parts.
+"""Planner-in-the-loop PPO, the paper's method (docs/design.md §7), jitted parts.
 
 One iteration:
   1. roll out `num_envs` whole episodes (up to `episode_length` steps, fresh
@@ -63,7 +63,9 @@ class EpisodeBatch:
     guide_length: jax.Array
 
 
-def rollout_episodes(config: TrainConfig, network, state: TrainState, field: Heightfield, key) -> EpisodeBatch:
+def rollout_episodes(
+    config: TrainConfig, network, state: TrainState, field: Heightfield, key
+) -> EpisodeBatch:
     """`config.num_envs` whole episodes from fresh random starts (pure, jittable)."""
     env_config = config.env
     env = LeasEnv(field, env_config)
@@ -75,27 +77,48 @@ def rollout_episodes(config: TrainConfig, network, state: TrainState, field: Hei
         env_state, alive = carry  # alive: [N] 1 while the episode runs
         actions, extras = policy(env_state.obs, k)
         new = jax.vmap(env.step)(env_state, actions)
-        record = dict(observation=env_state.obs, raw_action=extras["raw_action"], log_prob=extras["log_prob"],
-                      reward=new.reward * alive, done=new.done * alive, truncation=new.info["truncation"] * alive,
-                      alive=alive, invalid=new.metrics["invalid"] * alive)
+        record = dict(
+            observation=env_state.obs,
+            raw_action=extras["raw_action"],
+            log_prob=extras["log_prob"],
+            reward=new.reward * alive,
+            done=new.done * alive,
+            truncation=new.info["truncation"] * alive,
+            alive=alive,
+            invalid=new.metrics["invalid"] * alive,
+        )
         # finished episodes keep their last state (their later steps are padding)
         running = lambda x: (alive > 0).reshape(alive.shape + (1,) * (x.ndim - 1))  # noqa: E731
         env_state = jax.tree.map(lambda a, b: jnp.where(running(a), a, b), new, env_state)
         record["pose"] = env_state.pipeline_state.pose
         return (env_state, alive * (1 - new.done)), record
 
-    _, rec = jax.lax.scan(step, (start, jnp.ones(config.num_envs)),
-                          jax.random.split(k_steps, env_config.episode_length))
+    _, rec = jax.lax.scan(
+        step, (start, jnp.ones(config.num_envs)), jax.random.split(k_steps, env_config.episode_length)
+    )
     rec = jax.tree.map(lambda x: jnp.swapaxes(x, 0, 1), rec)  # [N, T, ...]
     poses = jnp.concatenate([start.pipeline_state.pose[:, None], rec["pose"]], axis=1)
     guide_length = 1 + (rec["alive"] - rec["invalid"]).sum(axis=1).astype(jnp.int32)
-    return EpisodeBatch(observation=rec["observation"], raw_action=rec["raw_action"], log_prob=rec["log_prob"],
-                        reward=rec["reward"], done=rec["done"], truncation=rec["truncation"], alive=rec["alive"],
-                        poses=poses, guide_length=guide_length)
+    return EpisodeBatch(
+        observation=rec["observation"],
+        raw_action=rec["raw_action"],
+        log_prob=rec["log_prob"],
+        reward=rec["reward"],
+        done=rec["done"],
+        truncation=rec["truncation"],
+        alive=rec["alive"],
+        poses=poses,
+        guide_length=guide_length,
+    )
 
 
-def prune_after_failure(alive: np.ndarray, done: np.ndarray, truncation: np.ndarray,
-                        guide_length: np.ndarray, last_valid_index: np.ndarray):
+def prune_after_failure(
+    alive: np.ndarray,
+    done: np.ndarray,
+    truncation: np.ndarray,
+    guide_length: np.ndarray,
+    last_valid_index: np.ndarray,
+):
     """Cut episodes after the contact generator's last valid pose (host, NumPy).
 
     Step t moves the root from guide pose t to pose t + 1. With l = last valid
@@ -138,9 +161,14 @@ def masked_ppo_loss(params, normalizer, batch: dict, rng, network, config: Train
     termination = batch["done"] * (1.0 - truncation)
     tm = lambda x: jnp.swapaxes(x, 0, 1)  # noqa: E731  [B, T] -> [T, B]
     vs, advantages = ppo_losses.compute_gae(
-        truncation=tm(truncation), termination=tm(termination), rewards=tm(batch["reward"] * config.reward_scaling),
-        values=tm(values), bootstrap_value=jnp.zeros(values.shape[0]), lambda_=config.gae_lambda,
-        discount=config.discounting)
+        truncation=tm(truncation),
+        termination=tm(termination),
+        rewards=tm(batch["reward"] * config.reward_scaling),
+        values=tm(values),
+        bootstrap_value=jnp.zeros(values.shape[0]),
+        lambda_=config.gae_lambda,
+        discount=config.discounting,
+    )
     vs, advantages = tm(vs), tm(advantages)
     count = jnp.maximum(mask.sum(), 1.0)
     mean = lambda x: (x * mask).sum() / count  # noqa: E731
@@ -187,10 +215,17 @@ def make_planner_fns(config: TrainConfig):
 
         rate = planner_learning_rate(config, state.env_steps)
         (params, opt_state), metrics = jax.lax.scan(
-            epoch, (state.params, with_learning_rate(state.optimizer_state, rate)),
-            jax.random.split(key, config.num_epochs))
-        state = state.replace(params=params, optimizer_state=opt_state, normalizer=normalizer,
-                              env_steps=state.env_steps + kept.astype(jnp.int32), iteration=state.iteration + 1)
+            epoch,
+            (state.params, with_learning_rate(state.optimizer_state, rate)),
+            jax.random.split(key, config.num_epochs),
+        )
+        state = state.replace(
+            params=params,
+            optimizer_state=opt_state,
+            normalizer=normalizer,
+            env_steps=state.env_steps + kept.astype(jnp.int32),
+            iteration=state.iteration + 1,
+        )
         return state, {**{f"loss/{k}": v.mean() for k, v in metrics.items()}, "learning_rate": rate}
 
     return jax.jit(rollout), jax.jit(update)
@@ -205,16 +240,28 @@ def training_batch(episodes: EpisodeBatch, last_valid_index: np.ndarray) -> tupl
             episode_length, invalid_fraction (episodes ended by an invalid pose).
     """
     host = jax.device_get(episodes)
-    mask, done, truncation = prune_after_failure(host.alive, host.done, host.truncation, host.guide_length,
-                                                 last_valid_index)
-    batch = dict(observation=host.observation, raw_action=host.raw_action, log_prob=host.log_prob,
-                 reward=host.reward, done=done, truncation=truncation, mask=mask)
+    mask, done, truncation = prune_after_failure(
+        host.alive, host.done, host.truncation, host.guide_length, last_valid_index
+    )
+    batch = dict(
+        observation=host.observation,
+        raw_action=host.raw_action,
+        log_prob=host.log_prob,
+        reward=host.reward,
+        done=done,
+        truncation=truncation,
+        mask=mask,
+    )
     alive_steps = float(host.alive.sum())
     returns = (host.reward * mask).sum(axis=1)
-    stats = {"rolled_steps": alive_steps, "kept_steps": float(mask.sum()),
-             "discarded_fraction": 1.0 - float(mask.sum()) / max(alive_steps, 1.0),
-             "episode_return": float(returns.mean()), "episode_length": float(host.alive.sum(axis=1).mean()),
-             "invalid_fraction": float((host.done * (1 - host.truncation)).sum() / host.done.shape[0])}
+    stats = {
+        "rolled_steps": alive_steps,
+        "kept_steps": float(mask.sum()),
+        "discarded_fraction": 1.0 - float(mask.sum()) / max(alive_steps, 1.0),
+        "episode_return": float(returns.mean()),
+        "episode_length": float(host.alive.sum(axis=1).mean()),
+        "invalid_fraction": float((host.done * (1 - host.truncation)).sum() / host.done.shape[0]),
+    }
     return batch, stats
 
 

@@ -54,7 +54,9 @@ def load_policy(path: str | Path) -> Policy:
     path = Path(path)
     file = path / "policy.pkl" if path.is_dir() else path
     if not file.exists():
-        raise LeasError(f"{path}: no policy.pkl found (give a run directory from `leas train` or a policy.pkl file)")
+        raise LeasError(
+            f"{path}: no policy.pkl found (give a run directory from `leas train` or a policy.pkl file)"
+        )
     try:
         with open(file, "rb") as f:
             payload = pickle.load(f)
@@ -62,5 +64,10 @@ def load_policy(path: str | Path) -> Policy:
         raise LeasError(f"{file}: cannot read policy ({exc})") from exc
     if not isinstance(payload, dict) or payload.get("format") != "leas-policy-v1":
         raise LeasError(f"{file}: not a leas policy file (missing format 'leas-policy-v1')")
-    return Policy(config=TrainConfig.from_dict(payload["config"]), normalizer=payload["normalizer"],
-                  params=payload["policy_params"], env_steps=payload["env_steps"], source=str(file))
+    return Policy(
+        config=TrainConfig.from_dict(payload["config"]),
+        normalizer=payload["normalizer"],
+        params=payload["policy_params"],
+        env_steps=payload["env_steps"],
+        source=str(file),
+    )

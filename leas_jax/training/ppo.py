@@ -103,8 +103,9 @@ def init_state(config: TrainConfig, field: Heightfield) -> TrainState:
     optimizer = make_optimizer(config)
     key = jax.random.PRNGKey(config.seed)
     key, k_policy, k_value, k_env = jax.random.split(key, 4)
-    params = ppo_losses.PPONetworkParams(policy=network.policy_network.init(k_policy),
-                                         value=network.value_network.init(k_value))
+    params = ppo_losses.PPONetworkParams(
+        policy=network.policy_network.init(k_policy), value=network.value_network.init(k_value)
+    )
     normalizer = running_statistics.init_state(specs.Array((config.env.observation_size,), jnp.float32))
 
     @jax.jit
@@ -112,10 +113,17 @@ def init_state(config: TrainConfig, field: Heightfield) -> TrainState:
         return FreshResetVmap(LeasEnv(field, config.env)).reset(keys)
 
     env_state = reset(field, jax.random.split(k_env, config.num_envs))
-    return TrainState(params=params, optimizer_state=optimizer.init(params), normalizer=normalizer,
-                      env_state=env_state, episode_return=jnp.zeros(config.num_envs),
-                      episode_length=jnp.zeros(config.num_envs), key=key,
-                      env_steps=jnp.zeros((), jnp.int32), iteration=jnp.zeros((), jnp.int32))
+    return TrainState(
+        params=params,
+        optimizer_state=optimizer.init(params),
+        normalizer=normalizer,
+        env_state=env_state,
+        episode_return=jnp.zeros(config.num_envs),
+        episode_length=jnp.zeros(config.num_envs),
+        key=key,
+        env_steps=jnp.zeros((), jnp.int32),
+        iteration=jnp.zeros((), jnp.int32),
+    )
 
 
 def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield, key):
@@ -145,46 +153,68 @@ def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield,
             "reward": nstate.reward.mean(),
         }
         transition = Transition(
-            observation=env_state.obs, action=actions, reward=nstate.reward, discount=1 - done,
+            observation=env_state.obs,
+            action=actions,
+            reward=nstate.reward,
+            discount=1 - done,
             next_observation=(),  # filled after the scan: the final observation only
-            extras={"policy_extras": policy_extras, "state_extras": {"truncation": nstate.info["truncation"]}})
+            extras={
+                "policy_extras": policy_extras,
+                "state_extras": {"truncation": nstate.info["truncation"]},
+            },
+        )
         carry = (nstate, ep_return * (1 - done), ep_length * (1 - done))
         return carry, (transition, stats)
 
     carry = (state.env_state, state.episode_return, state.episode_length)
     (env_state, ep_return, ep_length), (data, stats) = jax.lax.scan(
-        step, carry, jax.random.split(key, config.unroll_length))
+        step, carry, jax.random.split(key, config.unroll_length)
+    )
     data = jax.tree.map(lambda x: jnp.swapaxes(x, 0, 1), data)  # [B, T, ...]
     data = data._replace(next_observation=env_state.obs[:, None])  # [B, 1, 81]
-    stats = {k: (v.sum() if k in ("episodes", "episode_return_sum", "episode_length_sum", "invalid_episodes")
-                 else v.mean()) for k, v in stats.items()}
+    stats = {
+        k: (
+            v.sum()
+            if k in ("episodes", "episode_return_sum", "episode_length_sum", "invalid_episodes")
+            else v.mean()
+        )
+        for k, v in stats.items()
+    }
     return state.replace(env_state=env_state, episode_return=ep_return, episode_length=ep_length), data, stats
 
 
 def _sgd(config: TrainConfig, network, optimizer, state: TrainState, data: Transition, key):
     """`num_epochs` passes of `num_minibatches` PPO gradient steps over the batch."""
     loss_fn = functools.partial(
-        ppo_losses.compute_ppo_loss, ppo_network=network, entropy_cost=config.entropy_cost,
-        discounting=config.discounting, reward_scaling=config.reward_scaling,
-        gae_lambda=config.gae_lambda, clipping_epsilon=config.clipping_epsilon,
-        normalize_advantage=True, vf_coefficient=config.vf_coefficient)
+        ppo_losses.compute_ppo_loss,
+        ppo_network=network,
+        entropy_cost=config.entropy_cost,
+        discounting=config.discounting,
+        reward_scaling=config.reward_scaling,
+        gae_lambda=config.gae_lambda,
+        clipping_epsilon=config.clipping_epsilon,
+        normalize_advantage=True,
+        vf_coefficient=config.vf_coefficient,
+    )
     update = gradients.gradient_update_fn(loss_fn, optimizer, pmap_axis_name=None, has_aux=True)
 
     def minibatch(carry, inputs):
         params, opt_state = carry
         batch, k = inputs
-        (_, metrics), params, opt_state = update(params, state.normalizer, batch, k, optimizer_state=opt_state)
+        (_, metrics), params, opt_state = update(
+            params, state.normalizer, batch, k, optimizer_state=opt_state
+        )
         return (params, opt_state), metrics
 
     def epoch(carry, k):
         k_perm, k_mb = jax.random.split(k)
         perm = jax.random.permutation(k_perm, config.num_envs)
-        shuffled = jax.tree.map(
-            lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), data)
+        shuffled = jax.tree.map(lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), data)
         return jax.lax.scan(minibatch, carry, (shuffled, jax.random.split(k_mb, config.num_minibatches)))
 
     (params, opt_state), metrics = jax.lax.scan(
-        epoch, (state.params, state.optimizer_state), jax.random.split(key, config.num_epochs))
+        epoch, (state.params, state.optimizer_state), jax.random.split(key, config.num_epochs)
+    )
     metrics = {f"loss/{k}": v.mean() for k, v in metrics.items()}
     return state.replace(params=params, optimizer_state=opt_state), metrics
 
@@ -198,13 +228,18 @@ def flat_batch_networks(network: ppo_networks.PPONetworks) -> ppo_networks.PPONe
     products of a 2-D input; the loss's gradient took 40 % less time with the
     batch flattened. Same parameters and results (up to float rounding).
     """
+
     def flat(ffn: brax_networks.FeedForwardNetwork) -> brax_networks.FeedForwardNetwork:
         def apply(normalizer, params, obs):
             """obs: [..., 81] -> [..., outputs], through a [prod(...), 81] batch."""
             out = ffn.apply(normalizer, params, obs.reshape((-1, obs.shape[-1])))
             return out.reshape(obs.shape[:-1] + out.shape[1:])
+
         return brax_networks.FeedForwardNetwork(init=ffn.init, apply=apply)
-    return network.replace(policy_network=flat(network.policy_network), value_network=flat(network.value_network))
+
+    return network.replace(
+        policy_network=flat(network.policy_network), value_network=flat(network.value_network)
+    )
 
 
 def make_train_call(config: TrainConfig):
@@ -221,13 +256,15 @@ def make_train_call(config: TrainConfig):
         state, data, stats = _unroll(config, network, state, field, k_unroll)
         state = state.replace(normalizer=running_statistics.update(state.normalizer, data.observation))
         state, losses = _sgd(config, network, optimizer, state, data, k_sgd)
-        state = state.replace(key=key, env_steps=state.env_steps + config.batch_size,
-                              iteration=state.iteration + 1)
+        state = state.replace(
+            key=key, env_steps=state.env_steps + config.batch_size, iteration=state.iteration + 1
+        )
         return state, {**stats, **losses}
 
     def call(state: TrainState, field: Heightfield):
-        state, metrics = jax.lax.scan(lambda s, _: iteration(s, field), state, None,
-                                      length=config.iterations_per_call)
+        state, metrics = jax.lax.scan(
+            lambda s, _: iteration(s, field), state, None, length=config.iterations_per_call
+        )
         summed = ("episodes", "episode_return_sum", "episode_length_sum", "invalid_episodes")
         return state, {k: (v.sum() if k in summed else v.mean()) for k, v in metrics.items()}
 

@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from leas_jax.contacts.ik import leg_fk
-from leas_jax.contacts.model import LEG_PREFIXES, TalosModel, load_talos
+from leas_jax.contacts.robot.ik import leg_fk
+from leas_jax.contacts.robot.model import LEG_PREFIXES, TalosModel, load_talos
 
 _FORMAT_VERSION = 1
 
@@ -42,7 +42,12 @@ class DatabaseConfig:
 
     samples: int = 20000  # raw draws per leg; ~10^4 kept samples give a few mm spacing in the sole plane
     seed: int = 0  # numpy default_rng seed
-    collision_links: tuple[int, ...] = (3, 4, 5, 6)  # leg links checked against the body (hip links 1-2 sit inside the pelvis)
+    collision_links: tuple[int, ...] = (
+        3,
+        4,
+        5,
+        6,
+    )  # leg links checked against the body (hip links 1-2 sit inside the pelvis)
 
 
 @dataclass(frozen=True)
@@ -68,7 +73,9 @@ class LegDatabase:
 
     def near(self, point, radius: float) -> np.ndarray:
         """Indices of the samples within `radius` (m) of `point` [3] (root frame)."""
-        return np.asarray(self.tree.query_ball_point(np.asarray(point, dtype=np.float64), radius), dtype=np.int64)
+        return np.asarray(
+            self.tree.query_ball_point(np.asarray(point, dtype=np.float64), radius), dtype=np.int64
+        )
 
     def near_column(self, point, radius: float, half_height: float) -> np.ndarray:
         """Indices (sorted) of the samples in the vertical cylinder of `radius` and +-`half_height`
@@ -210,7 +217,9 @@ def _from_joints(talos: TalosModel, side: int, q_leg: np.ndarray) -> LegDatabase
         array.setflags(write=False)
     yaw = np.arctan2(rot[:, 1, 0], rot[:, 0, 0])
     yaw.setflags(write=False)
-    return LegDatabase(side=side, q=q_leg, positions=pos, yaw=yaw, tree=cKDTree(pos), tree_xy=cKDTree(pos[:, :2]))
+    return LegDatabase(
+        side=side, q=q_leg, positions=pos, yaw=yaw, tree=cKDTree(pos), tree_xy=cKDTree(pos[:, :2])
+    )
 
 
 def _load_or_build(talos: TalosModel, side: int, config: DatabaseConfig) -> np.ndarray:

@@ -28,11 +28,11 @@ import numpy as np
 # z = 0, base_link at z = 1.01927 m; `tests/test_contacts_model.py` re-measures it).
 # Guide paths give the root z as this base-link height.
 NOMINAL_ROOT_HEIGHT = 1.01927  # m
-# Sole rectangle, DESIGN §6 check 1 (the Talos foot sole is about 0.20 x 0.13 m),
+# Sole rectangle, docs/design.md §6 check 1 (the Talos foot sole is about 0.20 x 0.13 m),
 # centred on the sole frame, long side along the sole frame x axis.
 SOLE_LENGTH = 0.20  # m, along sole x
 SOLE_WIDTH = 0.13  # m, along sole y
-FRICTION = 0.5  # friction coefficient, DESIGN §6 checks 1 and 4
+FRICTION = 0.5  # friction coefficient, docs/design.md §6 checks 1 and 4
 SOLE_FRAMES = ("leg_left_sole_fix_joint", "leg_right_sole_fix_joint")
 LEG_PREFIXES = ("leg_left", "leg_right")
 LEFT, RIGHT = 0, 1
@@ -41,7 +41,7 @@ NQ = 39  # Talos free-flyer configuration size (7 + 32 joints)
 # spans z in [-0.1074, 0.053] in the ankle frame, sole at -0.107). A foot resting on
 # a face would always "collide" with it, so the foot meshes are raised by this much
 # along the sole normal for terrain collision; it equals the 5 mm contact tolerance
-# of DESIGN §6 check 1.
+# of docs/design.md §6 check 1.
 FOOT_CLEARANCE = 0.005  # m
 # Leg joint order inside a leg: hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle roll.
 _LEG_AXES = ("Z", "X", "Y", "Y", "Y", "X")
@@ -93,20 +93,48 @@ def quat_xyzw_from_matrix(rot) -> np.ndarray:
         r = m[sel]
         if case == 0:
             s = 2.0 * np.sqrt(1.0 + tr[sel])
-            q[sel] = np.stack([(r[:, 2, 1] - r[:, 1, 2]) / s, (r[:, 0, 2] - r[:, 2, 0]) / s,
-                               (r[:, 1, 0] - r[:, 0, 1]) / s, 0.25 * s], axis=1)
+            q[sel] = np.stack(
+                [
+                    (r[:, 2, 1] - r[:, 1, 2]) / s,
+                    (r[:, 0, 2] - r[:, 2, 0]) / s,
+                    (r[:, 1, 0] - r[:, 0, 1]) / s,
+                    0.25 * s,
+                ],
+                axis=1,
+            )
         elif case == 1:
             s = 2.0 * np.sqrt(1.0 + r[:, 0, 0] - r[:, 1, 1] - r[:, 2, 2])
-            q[sel] = np.stack([0.25 * s, (r[:, 0, 1] + r[:, 1, 0]) / s, (r[:, 0, 2] + r[:, 2, 0]) / s,
-                               (r[:, 2, 1] - r[:, 1, 2]) / s], axis=1)
+            q[sel] = np.stack(
+                [
+                    0.25 * s,
+                    (r[:, 0, 1] + r[:, 1, 0]) / s,
+                    (r[:, 0, 2] + r[:, 2, 0]) / s,
+                    (r[:, 2, 1] - r[:, 1, 2]) / s,
+                ],
+                axis=1,
+            )
         elif case == 2:
             s = 2.0 * np.sqrt(1.0 + r[:, 1, 1] - r[:, 0, 0] - r[:, 2, 2])
-            q[sel] = np.stack([(r[:, 0, 1] + r[:, 1, 0]) / s, 0.25 * s, (r[:, 1, 2] + r[:, 2, 1]) / s,
-                               (r[:, 0, 2] - r[:, 2, 0]) / s], axis=1)
+            q[sel] = np.stack(
+                [
+                    (r[:, 0, 1] + r[:, 1, 0]) / s,
+                    0.25 * s,
+                    (r[:, 1, 2] + r[:, 2, 1]) / s,
+                    (r[:, 0, 2] - r[:, 2, 0]) / s,
+                ],
+                axis=1,
+            )
         else:
             s = 2.0 * np.sqrt(1.0 + r[:, 2, 2] - r[:, 0, 0] - r[:, 1, 1])
-            q[sel] = np.stack([(r[:, 0, 2] + r[:, 2, 0]) / s, (r[:, 1, 2] + r[:, 2, 1]) / s, 0.25 * s,
-                               (r[:, 1, 0] - r[:, 0, 1]) / s], axis=1)
+            q[sel] = np.stack(
+                [
+                    (r[:, 0, 2] + r[:, 2, 0]) / s,
+                    (r[:, 1, 2] + r[:, 2, 1]) / s,
+                    0.25 * s,
+                    (r[:, 1, 0] - r[:, 0, 1]) / s,
+                ],
+                axis=1,
+            )
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     q *= np.where(q[:, 3:4] < 0.0, -1.0, 1.0)
     return q.reshape(rot.shape[:-2] + (4,))
@@ -259,15 +287,17 @@ class TalosModel:
         self.q_ref.setflags(write=False)
         self.mass = float(pin.computeTotalMass(self.model))
         self.sole_frame_ids = tuple(self.model.getFrameId(name) for name in SOLE_FRAMES)
-        self.legs = tuple(_leg_kinematics(self.model, prefix, frame)
-                          for prefix, frame in zip(LEG_PREFIXES, SOLE_FRAMES))
+        self.legs = tuple(
+            _leg_kinematics(self.model, prefix, frame) for prefix, frame in zip(LEG_PREFIXES, SOLE_FRAMES)
+        )
         self.lower = np.array(self.model.lowerPositionLimit)
         self.upper = np.array(self.model.upperPositionLimit)
 
         pin.framesForwardKinematics(self.model, self.data, q_ref)
         self.nominal_sole_in_root = np.array([self.data.oMf[fid].translation for fid in self.sole_frame_ids])
         self.geom_model, self.leg_geom_ids, self.foot_geom_ids = _collision_geometry(
-            robot.collision_model, self.model)
+            robot.collision_model, self.model
+        )
         self.geom_data = pin.GeometryData(self.geom_model)
 
     def configuration(self, root_pos, root_rot, leg_q) -> np.ndarray:
@@ -313,7 +343,9 @@ class TalosModel:
 
         return np.array(pin.centerOfMass(self.model, self.data, q))
 
-    def joint_limit_violations(self, q: np.ndarray, tol: float = 1e-9) -> list[tuple[str, float, float, float]]:
+    def joint_limit_violations(
+        self, q: np.ndarray, tol: float = 1e-9
+    ) -> list[tuple[str, float, float, float]]:
         """Actuated joints outside their limits.
 
         Args:
@@ -357,11 +389,16 @@ def _leg_kinematics(model, prefix: str, sole_frame: str) -> LegKinematics:
         if not np.allclose(placements[k].translation[:2], 0.0, atol=1e-9):
             problems.append(f"{model.names[jids[k]]} offset is not along z")
     frame = model.frames[model.getFrameId(sole_frame)]
-    if frame.parentJoint != jids[5] or not np.allclose(frame.placement.rotation, np.eye(3), atol=1e-9) \
-            or not np.allclose(frame.placement.translation[:2], 0.0, atol=1e-9):
+    if (
+        frame.parentJoint != jids[5]
+        or not np.allclose(frame.placement.rotation, np.eye(3), atol=1e-9)
+        or not np.allclose(frame.placement.translation[:2], 0.0, atol=1e-9)
+    ):
         problems.append(f"{sole_frame} is not straight below {model.names[jids[5]]}")
     if problems:
-        raise RuntimeError("Talos leg structure differs from what the analytic IK assumes: " + "; ".join(problems))
+        raise RuntimeError(
+            "Talos leg structure differs from what the analytic IK assumes: " + "; ".join(problems)
+        )
     q_index = np.array([model.joints[j].idx_q for j in jids])
     v_index = np.array([model.joints[j].idx_v for j in jids])
     return LegKinematics(

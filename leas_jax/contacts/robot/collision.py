@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from leas_jax.contacts.model import LEFT, RIGHT, TalosModel
+from leas_jax.contacts.robot.model import LEFT, RIGHT, TalosModel
 
 # Leg links whose meshes are checked for leg-leg and leg-body self-collision: thigh,
 # shin, ankle pitch and foot (links 1-2 sit inside the pelvis and always touch it).
@@ -52,7 +52,7 @@ class TerrainCollision:
         return np.flatnonzero(near)
 
 
-_TERRAIN_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_TERRAIN_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def terrain_collision(terrain) -> TerrainCollision:
@@ -64,7 +64,9 @@ def terrain_collision(terrain) -> TerrainCollision:
         shapes, transforms, aabb = [], [], []
         for box in terrain.boxes:
             shapes.append(coal.Box(*(float(s) for s in box.size)))
-            transforms.append(coal.Transform3s(np.array(box.rotation), np.array(box.center, dtype=np.float64)))
+            transforms.append(
+                coal.Transform3s(np.array(box.rotation), np.array(box.center, dtype=np.float64))
+            )
             aabb.append(box.aabb())
         cached = TerrainCollision(shapes, transforms, np.array(aabb).reshape(-1, 2, 3))
         _TERRAIN_CACHE[terrain] = cached
@@ -139,13 +141,16 @@ class RobotCollision:
             for b in range(len(self.names)):
                 if (a, b) not in allowed and (b, a) not in allowed:
                     continue
-                if self.leg_of[b] == -1 or (self.leg_of[b] != self.leg_of[a] and self.leg_link[b] in SELF_COLLISION_LINKS):
+                if self.leg_of[b] == -1 or (
+                    self.leg_of[b] != self.leg_of[a] and self.leg_link[b] in SELF_COLLISION_LINKS
+                ):
                     if self.leg_of[b] == -1 or a < b:
                         pairs.append((a, b))
         return np.array(sorted(set(pairs)), dtype=np.int64).reshape(-1, 2)
 
-    def placements_fast(self, talos: TalosModel, root_R: np.ndarray, root_p: np.ndarray,
-                        leg_q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def placements_fast(
+        self, talos: TalosModel, root_R: np.ndarray, root_p: np.ndarray, leg_q: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         """World placements of all geometries by NumPy forward kinematics.
 
         The upper body is rigid at half-sitting, so its geometries follow the root;
@@ -164,7 +169,9 @@ class RobotCollision:
         oMroot[:3, 3] = root_p
         oMg = oMroot @ self.rootMg_upper
         frames = _legs_joint_frames(self._leg_hip, self._leg_thigh, self._leg_shin, leg_q)  # [2, 6, 4, 4]
-        oMg[self._leg_geoms] = oMroot @ frames[self._leg_side, self._leg_frame] @ self.joint_geom[self._leg_geoms]
+        oMg[self._leg_geoms] = (
+            oMroot @ frames[self._leg_side, self._leg_frame] @ self.joint_geom[self._leg_geoms]
+        )
         return oMg[:, :3, :3], oMg[:, :3, 3]
 
     def placements_pinocchio(self, talos: TalosModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -181,8 +188,14 @@ class RobotCollision:
         half = np.einsum("gij,gj->gi", np.abs(rot), self.local_half)
         return np.stack([center - half, center + half], axis=1)
 
-    def terrain_contacts(self, rot: np.ndarray, pos: np.ndarray, terrain: TerrainCollision,
-                         first_only: bool = True, aabb: np.ndarray | None = None) -> list[tuple[int, int]]:
+    def terrain_contacts(
+        self,
+        rot: np.ndarray,
+        pos: np.ndarray,
+        terrain: TerrainCollision,
+        first_only: bool = True,
+        aabb: np.ndarray | None = None,
+    ) -> list[tuple[int, int]]:
         """Geometry/terrain-box pairs in collision.
 
         Args:
@@ -213,14 +226,17 @@ class RobotCollision:
             b = near[k]
             result.clear()
             tf = coal.Transform3s(rot[g], pos[g])
-            if coal.collide(self.geometries[g], tf, terrain.shapes[b], terrain.transforms[b], request, result):
+            if coal.collide(
+                self.geometries[g], tf, terrain.shapes[b], terrain.transforms[b], request, result
+            ):
                 hits.append((int(g), int(b)))
                 if first_only:
                     break
         return hits
 
-    def self_contacts(self, rot: np.ndarray, pos: np.ndarray, first_only: bool = True,
-                      aabb: np.ndarray | None = None) -> list[tuple[int, int]]:
+    def self_contacts(
+        self, rot: np.ndarray, pos: np.ndarray, first_only: bool = True, aabb: np.ndarray | None = None
+    ) -> list[tuple[int, int]]:
         """Self-collision pairs (legs vs legs, legs vs upper body) in collision, same conventions."""
         import coal
 
@@ -240,8 +256,14 @@ class RobotCollision:
         result = coal.CollisionResult()
         for ga, gb in pairs.tolist():
             result.clear()
-            if coal.collide(self.geometries[ga], coal.Transform3s(rot[ga], pos[ga]),
-                            self.geometries[gb], coal.Transform3s(rot[gb], pos[gb]), request, result):
+            if coal.collide(
+                self.geometries[ga],
+                coal.Transform3s(rot[ga], pos[ga]),
+                self.geometries[gb],
+                coal.Transform3s(rot[gb], pos[gb]),
+                request,
+                result,
+            ):
                 hits.append((int(ga), int(gb)))
                 if first_only:
                     break
@@ -285,7 +307,9 @@ _STEP_I = np.array([[1, 2, 0][a] for a in _STEP_AXIS])
 _STEP_J = np.array([[2, 0, 1][a] for a in _STEP_AXIS])
 
 
-def _legs_joint_frames(hip_offset: np.ndarray, thigh: np.ndarray, shin: np.ndarray, q: np.ndarray) -> np.ndarray:
+def _legs_joint_frames(
+    hip_offset: np.ndarray, thigh: np.ndarray, shin: np.ndarray, q: np.ndarray
+) -> np.ndarray:
     """Root-frame placements of both legs' six joint frames (after each joint's rotation).
 
     Args:

@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from leas_jax.contacts.model import LegKinematics
+from leas_jax.contacts.robot.model import LegKinematics
 
 
 def leg_ik(leg: LegKinematics, rootRsole, root_p_sole) -> tuple[np.ndarray, np.ndarray]:

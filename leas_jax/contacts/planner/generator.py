@@ -2,7 +2,7 @@
 
 Host-only (Pinocchio, coal, hpp-centroidal-dynamics, SciPy), not jittable.
 
-Algorithm (DESIGN §6, after the RB-PRM contact generator of Tonneau et al., T-RO
+Algorithm (docs/design.md §6, after the RB-PRM contact generator of Tonneau et al., T-RO
 2018, used by the paper through [7]):
 
 1. Contact planning runs on a subsampled guide: every `stride`-th pose plus the last.
@@ -38,17 +38,31 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from leas_jax.contacts.collision import robot_collision, terrain_collision
-from leas_jax.contacts.database import DatabaseConfig, leg_database
-from leas_jax.contacts.equilibrium import HppEquilibrium, flat_support_margin
-from leas_jax.contacts.ik import leg_ik, leg_ik_single
-from leas_jax.contacts.model import (FRICTION, LEFT, RIGHT, NOMINAL_ROOT_HEIGHT, SOLE_LENGTH, SOLE_WIDTH,
-                                     load_talos, quat_xyzw_from_matrix_single)
 from leas_jax.contacts.plan import ContactPlan, coverage_of
-from leas_jax.contacts.surfaces import (SOLE_CORNERS, height_at, sole_corners_world, sole_inside_union,
-                                        sole_rotation, sole_rotation_single, surface_arrays, uncovered)
+from leas_jax.contacts.planner.surfaces import (
+    SOLE_CORNERS,
+    height_at,
+    sole_corners_world,
+    sole_inside_union,
+    sole_rotation_single,
+    surface_arrays,
+    uncovered,
+)
+from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
+from leas_jax.contacts.robot.database import DatabaseConfig, leg_database
+from leas_jax.contacts.robot.equilibrium import HppEquilibrium, flat_support_margin
+from leas_jax.contacts.robot.ik import leg_ik, leg_ik_single
+from leas_jax.contacts.robot.model import (
+    FRICTION,
+    LEFT,
+    NOMINAL_ROOT_HEIGHT,
+    RIGHT,
+    SOLE_LENGTH,
+    SOLE_WIDTH,
+    load_talos,
+    quat_xyzw_from_matrix_single,
+)
 from leas_jax.errors import UsageError
-
 
 # m, how far outside the support polygon a CoM must be for `_build` to reject a flat
 # stance without the equilibrium LP (far above rounding, far below any real margin)
@@ -57,11 +71,11 @@ _OUTSIDE_MARGIN = 1e-6
 
 @dataclass(frozen=True)
 class GeneratorConfig:
-    """Settings of the contact generator; defaults from DESIGN §6 and the Talos model."""
+    """Settings of the contact generator; defaults from docs/design.md §6 and the Talos model."""
 
-    stride: int = 5  # guide poses per planning pose, DESIGN §6 ("every 5th pose by default")
-    lookahead: float = 0.7  # s, where a moving foot should land on the guide, DESIGN §6 (0.6-0.8 s)
-    mu: float = FRICTION  # friction coefficient, DESIGN §6 checks 1 and 4
+    stride: int = 5  # guide poses per planning pose, docs/design.md §6 ("every 5th pose by default")
+    lookahead: float = 0.7  # s, where a moving foot should land on the guide, docs/design.md §6 (0.6-0.8 s)
+    mu: float = FRICTION  # friction coefficient, docs/design.md §6 checks 1 and 4
     # m, horizontal lag of a foot behind its nominal place that makes it step. 0.07 m, not
     # 0.10: LeaS slows to ~0.06 m/s on eval_stairs and its root rises with each tread; with
     # 0.10 the trailing foot stayed a whole tread lower until the leg was overstretched
@@ -80,9 +94,13 @@ class GeneratorConfig:
     # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward
     max_foot_yaw: float = 0.5
     max_steps_per_pose: int = 2  # steps per planning pose (0.5 s at the default stride and timestep)
-    max_root_offset_xy: float = 0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
+    max_root_offset_xy: float = (
+        0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
+    )
     max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
-    min_knee: float = 0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
+    min_knee: float = (
+        0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
+    )
     candidate_radius: float = 0.15  # m, database samples this close to a step target are candidates
     candidate_slab: float = 0.10  # m, samples this close (vertically) to a face are dropped on it
     candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
@@ -95,14 +113,18 @@ class GeneratorConfig:
     # only: aligning soles to every face's edges cost 5 of 60 eval_stairs guides. Walking
     # along such a beam, each foot's step target also moves into its lane (`_beam_lane`).
     beam_width: float = 0.5  # m; the arena's bridges are 0.30-0.45 m wide, its stair treads 0.30 m deep
-    beam_align_yaw: float = 0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables (lanes too)
+    beam_align_yaw: float = (
+        0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables (lanes too)
+    )
     beam_drop: float = 0.05  # m, a beam's lanes need terrain this much lower this far beyond both its edges
-    # m, sole rectangle kept this far inside the face polygon (DESIGN §6's 5 mm tolerance). Two
+    # m, sole rectangle kept this far inside the face polygon (docs/design.md §6's 5 mm tolerance). Two
     # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin: with 1 cm and 2 cm that was
     # exactly the 0.30 m of eval_bridge, which no guide could cross: a centred straight guide at
     # 0.18 m/s stopped 8 cm onto it (tests/test_contacts_generator.py crosses it now)
     edge_margin: float = 0.005
-    cover_tol: float = 0.005  # m, a sole is covered if the terrain rises more than this above it (DESIGN §6: 5 mm)
+    cover_tol: float = (
+        0.005  # m, a sole is covered if the terrain rises more than this above it (docs/design.md §6: 5 mm)
+    )
     feet_gap: float = 0.01  # m, minimal gap between the two sole rectangles (see edge_margin)
     swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
     swing_clearance: float = 0.05  # m, how far out of its hip a lifted foot may be held (see `_step`)
@@ -110,7 +132,9 @@ class GeneratorConfig:
     # aimed instead at the point of that sole, this far inside its edges, nearest the guide
     # root (a shorter root shift; eval_circuit's pillars). 3 cm leaves twice flat_com_margin. None: off.
     single_support_com_inset: float | None = 0.03
-    min_robustness: float = 1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
+    min_robustness: float = (
+        1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
+    )
     # m, on horizontal faces a CoM this far inside the support polygon is in equilibrium
     # without solving the LP (equilibrium.flat_support_margin); 1.5 cm is ~5 x the CoM
     # margin of min_robustness, so the shortcut never accepts what the LP would reject
@@ -170,8 +194,10 @@ class ContactGenerator:
         self.equilibrium = HppEquilibrium(self.talos.mass, config.mu)
         self.databases = (leg_database(LEFT, config.database), leg_database(RIGHT, config.database))
         legs = self.talos.legs
-        self._reach = [math.sqrt(leg.thigh ** 2 + leg.shin ** 2 + 2 * leg.thigh * leg.shin * math.cos(config.min_knee))
-                       for leg in legs]
+        self._reach = [
+            math.sqrt(leg.thigh**2 + leg.shin**2 + 2 * leg.thigh * leg.shin * math.cos(config.min_knee))
+            for leg in legs
+        ]
         self._nominal = self.talos.nominal_sole_in_root  # [2, 3] root frame
         self._nominal_xy = [tuple(row[:2].tolist()) for row in self._nominal]
         self._beams = {}  # face index -> [A, 3] beam edges (`_beam_edges`)
@@ -230,7 +256,6 @@ class ContactGenerator:
         Returns:
             the posture, or None when no root offset gives a valid posture.
         """
-        cfg = self.config
         self.stats["postures_tried"] += 1
         root_R = _rotz(guide_pose[3])
         guide_xy = np.asarray(guide_pose[:2], dtype=np.float64)
@@ -240,7 +265,9 @@ class ContactGenerator:
         airs = [None] if air is None else [(air[0], *option) for option in air[1]]
         for offset in offsets:
             for one_air in airs:
-                built = self._build(guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, one_air)
+                built = self._build(
+                    guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, one_air
+                )
                 if built is not None:
                     return built
         return None
@@ -367,8 +394,13 @@ class ContactGenerator:
         target_pos = np.asarray(target_pos, dtype=np.float64)
         empty = np.zeros((0, 3)), np.zeros((0, 3, 3))
         reach = cfg.candidate_radius + 0.5 * math.hypot(SOLE_LENGTH, SOLE_WIDTH)
-        near = np.nonzero(np.all((surfaces.bbox[:, 0, :2] - reach <= target_pos[:2]) &
-                                 (surfaces.bbox[:, 1, :2] + reach >= target_pos[:2]), axis=1))[0]
+        near = np.nonzero(
+            np.all(
+                (surfaces.bbox[:, 0, :2] - reach <= target_pos[:2])
+                & (surfaces.bbox[:, 1, :2] + reach >= target_pos[:2]),
+                axis=1,
+            )
+        )[0]
         points, pending, owner, rotations, faces = [], [], [], [], []
         disk_xy, disk = None, None  # the samples' (x, y) test is the same for every face
         done = set()  # (coplanar group, sole yaw): its faces give the same candidates
@@ -452,10 +484,12 @@ class ContactGenerator:
         leg = self.talos.legs[side]
         local_rot = np.einsum("ji,njk->nik", root_R, rot)
         # Both root heights (guide, lowest allowed) in one call: leg_ik is row-wise.
-        local_pos = [(pos - (root_p - np.array([0.0, 0.0, dz]))) @ root_R for dz in (0.0, cfg.max_root_offset_z)]
+        local_pos = [
+            (pos - (root_p - np.array([0.0, 0.0, dz]))) @ root_R for dz in (0.0, cfg.max_root_offset_z)
+        ]
         q, within = leg_ik(leg, np.concatenate([local_rot, local_rot]), np.concatenate(local_pos))
         ok = within & np.all((q >= leg.lower) & (q <= leg.upper), axis=1)
-        reachable = ok[:len(pos)] | ok[len(pos):]
+        reachable = ok[: len(pos)] | ok[len(pos) :]
         self.stats["candidates"] += int(reachable.sum())
         keep = np.zeros(len(free), dtype=bool)
         keep[np.nonzero(free)[0][reachable]] = True
@@ -496,7 +530,9 @@ class ContactGenerator:
         cfg, surfaces = self.config, self.surfaces
         xy = np.asarray(target_pos[:2], dtype=np.float64)
         inner = 0.5 * SOLE_WIDTH + 0.5 * cfg.feet_gap
-        over = np.nonzero(np.all((surfaces.bbox[:, 0, :2] <= xy) & (surfaces.bbox[:, 1, :2] >= xy), axis=1))[0]
+        over = np.nonzero(np.all((surfaces.bbox[:, 0, :2] <= xy) & (surfaces.bbox[:, 1, :2] >= xy), axis=1))[
+            0
+        ]
         for s in over:
             beams = self._beam_edges(s)
             if len(beams) == 0 or not surfaces.inside(s, target_pos):
@@ -509,10 +545,14 @@ class ContactGenerator:
                     continue
                 normal = np.array([-math.sin(yaw), math.cos(yaw)])
                 across = float(xy @ normal)
-                beside = xy + np.outer([lo - cfg.beam_drop - across, hi + cfg.beam_drop - across], normal)  # [2, 2]
+                beside = xy + np.outer(
+                    [lo - cfg.beam_drop - across, hi + cfg.beam_drop - across], normal
+                )  # [2, 2]
                 if np.any(height_at(self.terrain, beside) > surfaces.plane_height(s, xy) - cfg.beam_drop):
                     continue
-                sign = (1.0 if along > 0 else -1.0) * (1.0 if side == LEFT else -1.0)  # the foot's side of the line
+                sign = (1.0 if along > 0 else -1.0) * (
+                    1.0 if side == LEFT else -1.0
+                )  # the foot's side of the line
                 offset = sign * (across - 0.5 * (lo + hi))
                 moved = np.array(target_pos, dtype=np.float64)
                 moved[:2] += (min(max(offset, inner), outer) - offset) * sign * normal
@@ -565,8 +605,10 @@ class ContactGenerator:
         # Columns of the projected axes as [N] arrays (a: candidates, b: the other sole);
         # written out component by component: the einsum form cost ~0.2 ms per call.
         ax0, ay0, ax1, ay1 = rot[:, 0, 0], rot[:, 1, 0], rot[:, 0, 1], rot[:, 1, 1]
-        bx0, by0, bx1, by1 = (np.full(len(pos), float(v)) for v in
-                              (other_rot[0, 0], other_rot[1, 0], other_rot[0, 1], other_rot[1, 1]))
+        bx0, by0, bx1, by1 = (
+            np.full(len(pos), float(v))
+            for v in (other_rot[0, 0], other_rot[1, 0], other_rot[0, 1], other_rot[1, 1])
+        )
         dx, dy = other_pos[0] - pos[:, 0], other_pos[1] - pos[:, 1]
         separated = np.zeros(len(pos), dtype=bool)
         for ux, uy in ((ax0, ay0), (ax1, ay1), (bx0, by0), (bx1, by1)):
@@ -606,10 +648,14 @@ class ContactGenerator:
 
         Position only: on a narrow beam soles turn to its axis, away from the target's yaw,
         and a yaw term made every such step look like no progress."""
-        return math.hypot(float(pos[0] - target_pos[0]), float(pos[1] - target_pos[1])) / self.config.step_trigger
+        return (
+            math.hypot(float(pos[0] - target_pos[0]), float(pos[1] - target_pos[1]))
+            / self.config.step_trigger
+        )
 
-    def _step(self, guide, timestep, index: int, feet, side: int,
-              min_gain: float | None = None) -> tuple[list[_Posture] | None, bool]:
+    def _step(
+        self, guide, timestep, index: int, feet, side: int, min_gain: float | None = None
+    ) -> tuple[list[_Posture] | None, bool]:
         """Move foot `side` at planning index `index`.
 
         min_gain: None, or the least cut of the foot's gap to its step target (`_step_gap`)
@@ -743,8 +789,10 @@ class ContactGenerator:
             return [left, right], posture
         lefts = list(zip(*self.candidates(LEFT, pose, left_target, left_yaw)))
         rights = {}  # left rank -> right candidates avoiding that left sole
-        pairs = sorted(((i, j) for i in range(len(lefts)) for j in range(self.config.max_candidates)),
-                       key=lambda ij: (ij[0] + ij[1], ij[0]))
+        pairs = sorted(
+            ((i, j) for i in range(len(lefts)) for j in range(self.config.max_candidates)),
+            key=lambda ij: (ij[0] + ij[1], ij[0]),
+        )
         tried = 0
         for i, j in pairs[1:]:
             if i not in rights:
@@ -821,7 +869,9 @@ class ContactGenerator:
         added: list[_Posture] = []
         for _ in range(cfg.max_steps_per_pose):
             lag = scores()
-            stepped = self._step_either(guide, timestep, index, feet, sorted((LEFT, RIGHT), key=lambda s: -lag[s]))
+            stepped = self._step_either(
+                guide, timestep, index, feet, sorted((LEFT, RIGHT), key=lambda s: -lag[s])
+            )
             if stepped is None:
                 break
             added.extend(stepped)
@@ -840,16 +890,25 @@ class ContactGenerator:
             guide_index = np.array([p.guide_index for p in postures], dtype=np.int64)
         else:
             q, feet, guide_index = np.zeros((0, 39)), np.zeros((0, 2, 7)), np.zeros(0, dtype=np.int64)
-        return ContactPlan(q=q, feet=feet, guide_index=guide_index, last_valid_index=last_valid,
-                           coverage=coverage_of(guide, last_valid), terrain=self.terrain.text, guide=guide,
-                           timestep=timestep)
+        return ContactPlan(
+            q=q,
+            feet=feet,
+            guide_index=guide_index,
+            last_valid_index=last_valid,
+            coverage=coverage_of(guide, last_valid),
+            terrain=self.terrain.text,
+            guide=guide,
+            timestep=timestep,
+        )
 
 
 _GENERATORS: dict = {}
 
 
-def plan_contacts(terrain, guide, timestep: float, config: GeneratorConfig = GeneratorConfig()) -> ContactPlan:
-    """Contact plan of a guide path on a terrain (DESIGN §6).
+def plan_contacts(
+    terrain, guide, timestep: float, config: GeneratorConfig = GeneratorConfig()
+) -> ContactPlan:
+    """Contact plan of a guide path on a terrain (docs/design.md §6).
 
     Host-only, not jittable. Reuses one ContactGenerator per (terrain object, config)
     in the process (the latest one only), so repeated calls on one terrain share its
@@ -878,7 +937,9 @@ def _generator(terrain, config: GeneratorConfig) -> ContactGenerator:
     return generator[1]
 
 
-def double_support_posture(terrain, pose, config: GeneratorConfig = GeneratorConfig()) -> ContactPosture | None:
+def double_support_posture(
+    terrain, pose, config: GeneratorConfig = GeneratorConfig()
+) -> ContactPosture | None:
     """Balanced, collision-free double-support posture of Talos at a root pose, or None.
 
     Host-only, not jittable. What the generator does for the first posture of a plan
@@ -894,5 +955,11 @@ def double_support_posture(terrain, pose, config: GeneratorConfig = GeneratorCon
     return _generator(terrain, config).double_support(pose)
 
 
-__all__ = ["ContactGenerator", "ContactPosture", "GeneratorConfig", "NOMINAL_ROOT_HEIGHT", "double_support_posture",
-           "plan_contacts"]
+__all__ = [
+    "ContactGenerator",
+    "ContactPosture",
+    "GeneratorConfig",
+    "NOMINAL_ROOT_HEIGHT",
+    "double_support_posture",
+    "plan_contacts",
+]

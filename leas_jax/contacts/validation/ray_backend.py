@@ -21,7 +21,7 @@ or an earlier pool), that connection is used whatever the address, and it stays
 open after the pool closes (the next pool reuses it; Ray shuts it down at exit).
 The cluster nodes need leas-jax installed with the same dependency set.
 
-Same semantics as the local worker processes (`leas_jax.contacts.pool`):
+Same semantics as the local worker processes (`leas_jax.contacts.validation.pool`):
 
 * `workers` Ray actors (default: the cluster's CPUs), one CPU each; every actor
   builds one `PathRunner(spec)` (Talos model, sample database, terrain) once
@@ -51,9 +51,19 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
-from leas_jax.contacts.pool import (_MAX_STARTUP_DEATHS, _POLL_INTERVAL, PathResult, PathRunner,
-                                    ValidationPoolError, WorkerSpec, _Job, _one_line, _QueuedBackend, _Task,
-                                    register_backend)
+from leas_jax.contacts.validation.pool import (
+    _MAX_STARTUP_DEATHS,
+    _POLL_INTERVAL,
+    PathResult,
+    PathRunner,
+    ValidationPoolError,
+    WorkerSpec,
+    _Job,
+    _one_line,
+    _QueuedBackend,
+    _Task,
+    register_backend,
+)
 from leas_jax.errors import UsageError
 
 SCHEMES = ("ray", "auto", "local")
@@ -103,8 +113,10 @@ def _import_ray(address: str):
     try:
         import ray
     except ImportError:
-        raise RayAddressError(f"address={address!r}: the Ray backend needs Ray, which is not installed: "
-                              "pip install 'leas-jax[cluster]'") from None
+        raise RayAddressError(
+            f"address={address!r}: the Ray backend needs Ray, which is not installed: "
+            "pip install 'leas-jax[cluster]'"
+        ) from None
     return ray
 
 
@@ -119,22 +131,28 @@ def _connect(ray, address: str, workers: int | None) -> None:
             ray.init(address="local", num_cpus=workers, include_dashboard=False)
         return
     if address.startswith("ray://"):
-        host, _, port = address[len("ray://"):].rpartition(":")
+        host, _, port = address[len("ray://") :].rpartition(":")
         if not host or not port.isdigit():
-            raise RayAddressError(f"address={address!r}: expected ray://HOST:PORT (Ray client server, port "
-                                  "10001 by default)")
+            raise RayAddressError(
+                f"address={address!r}: expected ray://HOST:PORT (Ray client server, port 10001 by default)"
+            )
         try:
             socket.create_connection((host.strip("[]"), int(port)), timeout=_CONNECT_TIMEOUT).close()
         except OSError as exc:
-            raise RayAddressError(f"address={address!r}: cannot reach the Ray client server at {host}:{port} "
-                                  f"({_one_line(exc)})") from None
+            raise RayAddressError(
+                f"address={address!r}: cannot reach the Ray client server at {host}:{port} ({_one_line(exc)})"
+            ) from None
     elif address != "auto":
         raise RayAddressError(f"address={address!r}: expected ray://HOST:PORT, auto or local")
     try:
         ray.init(address=address)
     except (ConnectionError, RuntimeError, ValueError) as exc:
-        hint = (" (a cluster with token authentication also needs RAY_AUTH_MODE=token and its token here, "
-                "in RAY_AUTH_TOKEN or ~/.ray/auth_token)" if address.startswith("ray://") else "")
+        hint = (
+            " (a cluster with token authentication also needs RAY_AUTH_MODE=token and its token here, "
+            "in RAY_AUTH_TOKEN or ~/.ray/auth_token)"
+            if address.startswith("ray://")
+            else ""
+        )
         raise RayAddressError(f"address={address!r}: cannot connect to Ray: {_one_line(exc)}{hint}") from None
 
 
@@ -148,15 +166,27 @@ class RayBackend(_QueuedBackend):
         task_timeout, max_attempts, max_tasks_per_worker: as `ValidationPool`.
     """
 
-    def __init__(self, address: str, spec: WorkerSpec, workers: int | None, *, task_timeout: float | None,
-                 max_attempts: int, max_tasks_per_worker: int | None):
+    def __init__(
+        self,
+        address: str,
+        spec: WorkerSpec,
+        workers: int | None,
+        *,
+        task_timeout: float | None,
+        max_attempts: int,
+        max_tasks_per_worker: int | None,
+    ):
         if workers is not None and workers < 1:
-            raise UsageError(f"workers={workers}: a Ray pool needs at least one actor (workers=0 plans in "
-                             "this process: give no address)")
+            raise UsageError(
+                f"workers={workers}: a Ray pool needs at least one actor (workers=0 plans in "
+                "this process: give no address)"
+            )
         ray = _import_ray(address)
         _connect(ray, address, workers)
         self._ray = ray
-        self.workers = int(workers) if workers is not None else max(1, int(ray.cluster_resources().get("CPU", 1)))
+        self.workers = (
+            int(workers) if workers is not None else max(1, int(ray.cluster_resources().get("CPU", 1)))
+        )
         self._actor_class = ray.remote(_ActorWorker).options(num_cpus=1, max_restarts=0, max_task_retries=0)
         self._spec_ref = ray.put(spec)  # sent to the cluster once, shared by every actor
         self._task_timeout = task_timeout
@@ -200,12 +230,28 @@ class RayBackend(_QueuedBackend):
                     task.attempts += 1
                     if not actor.tasks:
                         actor.head_started = time.monotonic()
-                    actor.tasks.append((task, actor.handle.run.remote(
-                        task.index, task.guide, task.timestep, task.seed, task.attempts)))
+                    actor.tasks.append(
+                        (
+                            task,
+                            actor.handle.run.remote(
+                                task.index, task.guide, task.timestep, task.seed, task.attempts
+                            ),
+                        )
+                    )
 
     def _error(self, task: _Task, started: float, error: str) -> None:
-        self._complete(task, PathResult(index=task.index, coverage=0.0, last_valid_index=-1, plan=None,
-                                        error=error, attempts=task.attempts, seconds=time.monotonic() - started))
+        self._complete(
+            task,
+            PathResult(
+                index=task.index,
+                coverage=0.0,
+                last_valid_index=-1,
+                plan=None,
+                error=error,
+                attempts=task.attempts,
+                seconds=time.monotonic() - started,
+            ),
+        )
 
     def _break(self, exc: BaseException) -> None:
         self._fail_jobs(exc)
@@ -223,8 +269,12 @@ class RayBackend(_QueuedBackend):
             self._actors.remove(actor)
             self._startup_deaths += 1
             if self._startup_deaths >= _MAX_STARTUP_DEATHS:
-                self._break(ValidationPoolError(f"{self._startup_deaths} Ray actors died during start-up; "
-                                                f"the last one:\n{str(exc)[-2000:]}"))
+                self._break(
+                    ValidationPoolError(
+                        f"{self._startup_deaths} Ray actors died during start-up; "
+                        f"the last one:\n{str(exc)[-2000:]}"
+                    )
+                )
             return
         if error is not None:
             self._break(ValidationPoolError(f"contact worker start-up failed: {error[0]}\n{error[1]}"))
@@ -250,18 +300,32 @@ class RayBackend(_QueuedBackend):
             self._retire(actor)
             where = f"Ray actor (pid {actor.pid})"
             if actor.timed_out:
-                self._error(task, started, f"TimeoutError: path {task.index} took longer than "
-                                           f"{self._task_timeout:g} s ({where} killed)")
+                self._error(
+                    task,
+                    started,
+                    f"TimeoutError: path {task.index} took longer than "
+                    f"{self._task_timeout:g} s ({where} killed)",
+                )
             elif task.attempts < self._max_attempts:
                 self._queue.appendleft(task)  # retries go before later batches
             else:
-                self._error(task, started, f"WorkerDied: {where} died while planning path {task.index}, on "
-                                           f"each of {task.attempts} attempts ({_one_line(exc)})")
+                self._error(
+                    task,
+                    started,
+                    f"WorkerDied: {where} died while planning path {task.index}, on "
+                    f"each of {task.attempts} attempts ({_one_line(exc)})",
+                )
             return
         except Exception as exc:  # noqa: BLE001 - e.g. the result could not be sent back
-            result = PathResult(index=task.index, coverage=0.0, last_valid_index=-1, plan=None,
-                                error=f"path {task.index}: {_one_line(exc)}", attempts=task.attempts,
-                                seconds=time.monotonic() - started)
+            result = PathResult(
+                index=task.index,
+                coverage=0.0,
+                last_valid_index=-1,
+                plan=None,
+                error=f"path {task.index}: {_one_line(exc)}",
+                attempts=task.attempts,
+                seconds=time.monotonic() - started,
+            )
         actor.tasks_done += 1
         self._complete(task, result)
         # Recycle (bounds memory growth of native planners); or it finished just as it was killed for a timeout.
@@ -325,8 +389,14 @@ class RayBackend(_QueuedBackend):
 
 
 def _factory(address: str, spec: WorkerSpec, workers: int | None, options: dict) -> RayBackend:
-    return RayBackend(address, spec, workers, task_timeout=options["task_timeout"],
-                      max_attempts=options["max_attempts"], max_tasks_per_worker=options["max_tasks_per_worker"])
+    return RayBackend(
+        address,
+        spec,
+        workers,
+        task_timeout=options["task_timeout"],
+        max_attempts=options["max_attempts"],
+        max_tasks_per_worker=options["max_tasks_per_worker"],
+    )
 
 
 for _scheme in SCHEMES:

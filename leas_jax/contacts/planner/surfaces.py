@@ -3,7 +3,7 @@
 Host-only (NumPy), not jittable. Wraps `Terrain.support_surfaces(mu)` (box faces whose
 normal is within the friction cone) with what the generator and the verifier need:
 plane equations, polygon edges, bounding boxes, the sole orientation on a face and
-the "sole rectangle inside the face polygon" test of DESIGN §6 check 1.
+the "sole rectangle inside the face polygon" test of docs/design.md §6 check 1.
 
 A terrain face, for that test, is the union of the box faces of one plane that touch
 (`SurfaceArrays.group`): a sole may rest across two coplanar boxes, as on the
@@ -24,11 +24,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from leas_jax.contacts.model import SOLE_LENGTH, SOLE_WIDTH
+from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
 
 # Sole rectangle corners in the sole frame (x forward, y left), counter-clockwise.
-SOLE_CORNERS = np.array([[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0]
-                         for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
+SOLE_CORNERS = np.array(
+    [[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0] for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+)
 
 COPLANAR_NORMAL_TOL = 1e-6  # |n_a - n_b| below which two faces have the same normal
 COPLANAR_OFFSET_TOL = 1e-5  # m, |offset_a - offset_b| below which they lie in one plane
@@ -77,7 +78,7 @@ class SurfaceArrays:
         return _inside_edges(np.asarray(points, dtype=np.float64), self.edges[s], margin)
 
 
-_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def surface_arrays(terrain, mu: float) -> SurfaceArrays:
@@ -87,7 +88,9 @@ def surface_arrays(terrain, mu: float) -> SurfaceArrays:
         surfaces = tuple(terrain.support_surfaces(mu=mu))
         normals = np.array([s.normal for s in surfaces]).reshape(-1, 3)
         offsets = np.array([float(s.normal @ s.vertices[0]) for s in surfaces])
-        bbox = np.array([[s.vertices.min(axis=0), s.vertices.max(axis=0)] for s in surfaces]).reshape(-1, 2, 3)
+        bbox = np.array([[s.vertices.min(axis=0), s.vertices.max(axis=0)] for s in surfaces]).reshape(
+            -1, 2, 3
+        )
         group = coplanar_groups(normals, offsets, bbox)
         members = tuple(np.flatnonzero(group == g) for g in range(int(group.max(initial=-1)) + 1))
         edges = tuple(_edge_normals(s) for s in surfaces)
@@ -126,10 +129,13 @@ def coplanar_groups(normals: np.ndarray, offsets: np.ndarray, bbox: np.ndarray) 
         return i
 
     for i in range(count):
-        same_plane = ((np.linalg.norm(normals[i + 1:] - normals[i], axis=1) < COPLANAR_NORMAL_TOL)
-                      & (np.abs(offsets[i + 1:] - offsets[i]) < COPLANAR_OFFSET_TOL))
-        touching = np.all((bbox[i + 1:, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[i + 1:, 1] >= bbox[i, 0] - TOUCH_TOL),
-                          axis=1)
+        same_plane = (np.linalg.norm(normals[i + 1 :] - normals[i], axis=1) < COPLANAR_NORMAL_TOL) & (
+            np.abs(offsets[i + 1 :] - offsets[i]) < COPLANAR_OFFSET_TOL
+        )
+        touching = np.all(
+            (bbox[i + 1 :, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[i + 1 :, 1] >= bbox[i, 0] - TOUCH_TOL),
+            axis=1,
+        )
         for j in i + 1 + np.flatnonzero(same_plane & touching):
             a, b = root(i), root(int(j))
             if a != b:
@@ -148,8 +154,10 @@ def _sole_samples(grow: float) -> tuple[np.ndarray, np.ndarray]:
     half = np.array([SOLE_LENGTH / 2 + grow, SOLE_WIDTH / 2 + grow])
     edge = [np.linspace(-h, h, int(math.ceil(2 * h / UNION_EDGE_STEP)) + 1) for h in half]
     inner = [np.linspace(-h, h, int(math.ceil(2 * h / UNION_INNER_STEP)) + 1)[1:-1] for h in half]
-    border = np.concatenate([np.stack([edge[0], np.full_like(edge[0], sy * half[1])], axis=1) for sy in (-1, 1)]
-                            + [np.stack([np.full_like(edge[1], sx * half[0]), edge[1]], axis=1) for sx in (-1, 1)])
+    border = np.concatenate(
+        [np.stack([edge[0], np.full_like(edge[0], sy * half[1])], axis=1) for sy in (-1, 1)]
+        + [np.stack([np.full_like(edge[1], sx * half[0]), edge[1]], axis=1) for sx in (-1, 1)]
+    )
     grid = np.stack(np.meshgrid(*inner, indexing="ij"), axis=-1).reshape(-1, 2)
     points = np.unique(np.round(np.concatenate([border, grid]), 12), axis=0)
     points = np.concatenate([points, np.zeros((len(points), 1))], axis=1)
@@ -165,7 +173,7 @@ def _inside_edges(points: np.ndarray, edges: tuple, margin: float) -> np.ndarray
     return np.all(points @ inward.T >= bounds + margin, axis=-1)
 
 
-def sole_inside_union(surfaces: "SurfaceArrays", faces, pos, rot, margin: float) -> np.ndarray:
+def sole_inside_union(surfaces: SurfaceArrays, faces, pos, rot, margin: float) -> np.ndarray:
     """Whether sole rectangles lie inside the union of some faces of one plane, `margin` from its edges.
 
     Every sample point of the rectangle grown by `margin` (`_sole_samples`) must lie in
@@ -258,8 +266,10 @@ def inside_polygon(surface, points, margin: float = 0.0) -> np.ndarray:
     return _inside_edges(np.asarray(points, dtype=np.float64), _edge_normals(surface), margin)
 
 
-_BOUNDS_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_BOUND_MARGIN = 1e-3  # m, growth of the box footprints in `_height_bounds` (>> the terrain's 1e-7 m hit tolerance)
+_BOUNDS_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_BOUND_MARGIN = (
+    1e-3  # m, growth of the box footprints in `_height_bounds` (>> the terrain's 1e-7 m hit tolerance)
+)
 
 
 def _box_bounds(terrain) -> tuple:
@@ -272,8 +282,13 @@ def _box_bounds(terrain) -> tuple:
         foot = aabb[:, :, :2] + np.array([-_BOUND_MARGIN, _BOUND_MARGIN])[None, :, None]
         top = np.array([float(box.center[2] + box.half[2]) for box in boxes])
         # Yaw only, exactly: z axis (0, 0, 1) in both the box and the world frame.
-        tilted = np.array([bool(np.any(box.rotation[2] != (0.0, 0.0, 1.0)) or np.any(box.rotation[:2, 2] != 0.0))
-                           for box in boxes], dtype=bool)
+        tilted = np.array(
+            [
+                bool(np.any(box.rotation[2] != (0.0, 0.0, 1.0)) or np.any(box.rotation[:2, 2] != 0.0))
+                for box in boxes
+            ],
+            dtype=bool,
+        )
         _BOUNDS_CACHE[terrain] = (foot, top, tilted, _footprint_columns(foot[:, 0], foot[:, 1]))
     return _BOUNDS_CACHE[terrain]
 
@@ -307,14 +322,19 @@ def _height_bounds(terrain, xy: np.ndarray) -> np.ndarray:
     # Only the boxes whose footprint meets the points' bounding rectangle can hold one.
     near = _boxes_meeting(columns, xy)
     foot, top, tilted = foot[near], top[near], tilted[near]
-    hit = ((xy[:, None, 0] >= foot[None, :, 0, 0]) & (xy[:, None, 0] <= foot[None, :, 1, 0]) &
-           (xy[:, None, 1] >= foot[None, :, 0, 1]) & (xy[:, None, 1] <= foot[None, :, 1, 1]))  # [N, B']
-    bound = np.maximum(np.max(np.where(hit, top[None, :], -np.inf), axis=1, initial=-np.inf),
-                       float(terrain.void_height))
+    hit = (
+        (xy[:, None, 0] >= foot[None, :, 0, 0])
+        & (xy[:, None, 0] <= foot[None, :, 1, 0])
+        & (xy[:, None, 1] >= foot[None, :, 0, 1])
+        & (xy[:, None, 1] <= foot[None, :, 1, 1])
+    )  # [N, B']
+    bound = np.maximum(
+        np.max(np.where(hit, top[None, :], -np.inf), axis=1, initial=-np.inf), float(terrain.void_height)
+    )
     return np.where(np.any(hit & tilted[None, :], axis=1), np.inf, bound)
 
 
-_HEIGHT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_HEIGHT_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _column_bounds(terrain) -> tuple:
@@ -348,7 +368,9 @@ def height_at(terrain, xy: np.ndarray) -> np.ndarray:
     near = _boxes_meeting(columns, xy)
     lo, hi = lo[near], hi[near]
     x, y = xy[:, 0:1], xy[:, 1:2]
-    hit = (x >= lo[None, :, 0]) & (x <= hi[None, :, 0]) & (y >= lo[None, :, 1]) & (y <= hi[None, :, 1])  # [N, B']
+    hit = (
+        (x >= lo[None, :, 0]) & (x <= hi[None, :, 0]) & (y >= lo[None, :, 1]) & (y <= hi[None, :, 1])
+    )  # [N, B']
     top = np.full(len(xy), -np.inf)
     boxes = terrain.boxes
     for k in np.flatnonzero(hit.any(axis=0)).tolist():
@@ -381,9 +403,10 @@ def uncovered(terrain, points, tol: float) -> np.ndarray:
     return free
 
 
-def find_support(terrain, surfaces: SurfaceArrays, pos, rot, dist_tol: float, angle_tol: float,
-                 edge_tol: float) -> tuple[int, str]:
-    """The support surface a sole rests on, DESIGN §6 check 1.
+def find_support(
+    terrain, surfaces: SurfaceArrays, pos, rot, dist_tol: float, angle_tol: float, edge_tol: float
+) -> tuple[int, str]:
+    """The support surface a sole rests on, docs/design.md §6 check 1.
 
     Args:
         terrain: the Terrain (unused by the test itself; kept for messages).
@@ -417,8 +440,10 @@ def find_support(terrain, surfaces: SurfaceArrays, pos, rot, dist_tol: float, an
         score = abs(dist[s]) + angle[s] + (0 if inside.all() else 1.0)
         if score < best_score:
             best_score = score
-            best_reason = (f"closest face (box {surface.box_index}): plane distance {1000 * dist[s]:.1f} mm, "
-                           f"tilt {np.degrees(angle[s]):.2f} deg, {int((~inside).sum())} sole corners outside")
+            best_reason = (
+                f"closest face (box {surface.box_index}): plane distance {1000 * dist[s]:.1f} mm, "
+                f"tilt {np.degrees(angle[s]):.2f} deg, {int((~inside).sum())} sole corners outside"
+            )
     for group in np.unique(surfaces.group[on_plane]):
         members = surfaces.members[group]
         if len(members) > 1 and sole_inside_union(surfaces, members, pos, rot, -edge_tol)[0]:

@@ -1,6 +1,6 @@
 """Parallel validation of guide paths by the contact generator (host-only).
 
-The planner-in-the-loop trainer (DESIGN §7) rolls out thousands of guide paths
+The planner-in-the-loop trainer (docs/design.md §7) rolls out thousands of guide paths
 in JAX and asks the contact generator how far along each one it can plan
 contacts. Contact planning is slow, single-threaded host code (Pinocchio, coal,
 hpp-centroidal-dynamics), so the paths are spread over worker processes:
@@ -34,9 +34,9 @@ Design points (why):
   debuggers and profilers. An exception in the planner is still turned into an
   error result, but a crash of the planner takes the caller down with it.
   `workers >= 1` always uses subprocesses (one worker still isolates crashes).
-* `address=` runs the workers on a cluster (DESIGN §7: "the same interface
+* `address=` runs the workers on a cluster (docs/design.md §7: "the same interface
   accepts a Ray cluster address"): `address="ray://head:10001"`, `"auto"` or
-  `"local"` use the Ray backend of `leas_jax.contacts.ray_backend` (optional
+  `"local"` use the Ray backend of `leas_jax.contacts.validation.ray_backend` (optional
   extra `leas-jax[cluster]`; imported on first use). Other schemes look up a
   backend registered with `register_backend`. A backend receives a
   `WorkerSpec` and runs `PathRunner(spec).run(...)` on its remote workers, so
@@ -64,10 +64,11 @@ import threading
 import time
 import traceback as traceback_module
 import weakref
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass, field
 from multiprocessing.connection import wait as wait_for_ready
-from typing import Any, Callable, Protocol, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -78,7 +79,7 @@ from leas_jax.errors import LeasError, UsageError
 # ten minutes only catches a planner stuck in a loop.
 DEFAULT_TASK_TIMEOUT = 600.0  # s
 # A path is started at most this many times: once, plus one retry after its
-# worker died (the brief of DESIGN §7: retried once, then an error).
+# worker died (the brief of docs/design.md §7: retried once, then an error).
 DEFAULT_MAX_ATTEMPTS = 2
 # Workers that die before they report ready this many times in a row mean the
 # start-up itself is broken (bad install, bad plan_fn): fail instead of
@@ -107,7 +108,7 @@ class PathResult:
         index: position of the guide in the submitted list.
         coverage: arc-length fraction of the guide covered by the plan, in
             [0, 1]; 0.0 when `error` is set.
-        last_valid_index: guide index of the last valid posture (DESIGN §6);
+        last_valid_index: guide index of the last valid posture (docs/design.md §6);
             -1 when `error` is set (no part of the guide was validated).
         plan: the `ContactPlan`; None when `error` is set or the pool was made
             with `return_plans=False`.
@@ -139,7 +140,7 @@ class WorkerSpec:
     """Everything a worker needs to build its planner; picklable, sent once per worker.
 
     Attributes:
-        terrain_text: the terrain file text (TOML, DESIGN §4).
+        terrain_text: the terrain file text (TOML, docs/design.md §4).
         terrain_source: name used in terrain error messages (file path or "<...>").
         config: the generator config (`GeneratorConfig`), None for its defaults.
         plan_fn: None for `leas_jax.contacts.plan_contacts`, else a picklable
@@ -199,7 +200,7 @@ class PathRunner:
         if spec.plan_fn is None:
             # Imported here, not at module level: leas_jax.contacts imports this
             # module lazily, and only workers need the generator.
-            from leas_jax.contacts.generator import ContactGenerator, GeneratorConfig
+            from leas_jax.contacts.planner.generator import ContactGenerator, GeneratorConfig
 
             self.config = spec.config if spec.config is not None else GeneratorConfig()
             self._generator = ContactGenerator(self.terrain, self.config)
@@ -241,13 +242,25 @@ class PathRunner:
             coverage = float(plan.coverage)
             last_valid = int(plan.last_valid_index)
         except Exception as exc:
-            return PathResult(index=index, coverage=0.0, last_valid_index=-1, plan=None,
-                              error=_one_line(exc), attempts=attempts,
-                              seconds=time.perf_counter() - start,
-                              traceback=traceback_module.format_exc())
-        return PathResult(index=index, coverage=coverage, last_valid_index=last_valid,
-                          plan=plan if self.return_plans else None,
-                          error=None, attempts=attempts, seconds=time.perf_counter() - start)
+            return PathResult(
+                index=index,
+                coverage=0.0,
+                last_valid_index=-1,
+                plan=None,
+                error=_one_line(exc),
+                attempts=attempts,
+                seconds=time.perf_counter() - start,
+                traceback=traceback_module.format_exc(),
+            )
+        return PathResult(
+            index=index,
+            coverage=coverage,
+            last_valid_index=last_valid,
+            plan=plan if self.return_plans else None,
+            error=None,
+            attempts=attempts,
+            seconds=time.perf_counter() - start,
+        )
 
 
 def _worker_main(conn, spec: WorkerSpec) -> None:
@@ -282,9 +295,19 @@ def _worker_main(conn, spec: WorkerSpec) -> None:
         except (EOFError, OSError, BrokenPipeError):
             return
         except Exception as exc:  # the plan could not be pickled
-            conn.send(("done", key, dataclasses.replace(
-                result, plan=None, coverage=0.0, last_valid_index=-1,
-                error=f"result of path {index} could not be sent back: {_one_line(exc)}")))
+            conn.send(
+                (
+                    "done",
+                    key,
+                    dataclasses.replace(
+                        result,
+                        plan=None,
+                        coverage=0.0,
+                        last_valid_index=-1,
+                        error=f"result of path {index} could not be sent back: {_one_line(exc)}",
+                    ),
+                )
+            )
 
 
 # --------------------------------------------------------------------------- backends
@@ -318,7 +341,9 @@ class _InlineBackend:
             raise ValidationPoolError("submit() on a closed ValidationPool")
         future: Future = Future()
         future.set_running_or_notify_cancel()
-        future.set_result([self._runner.run(i, g, timestep, s) for i, (g, s) in enumerate(zip(guides, seeds))])
+        future.set_result(
+            [self._runner.run(i, g, timestep, s) for i, (g, s) in enumerate(zip(guides, seeds))]
+        )
         return future
 
     def close(self, cancel_pending=False):
@@ -436,8 +461,16 @@ class _ProcessBackend(_QueuedBackend):
     in-flight tasks for timeouts, respawns workers and completes futures.
     """
 
-    def __init__(self, spec: WorkerSpec, workers: int, *, task_timeout: float | None,
-                 max_attempts: int, max_tasks_per_worker: int | None, start_method: str):
+    def __init__(
+        self,
+        spec: WorkerSpec,
+        workers: int,
+        *,
+        task_timeout: float | None,
+        max_attempts: int,
+        max_tasks_per_worker: int | None,
+        start_method: str,
+    ):
         self.workers = workers
         self._spec = spec
         self._context = multiprocessing.get_context(start_method)
@@ -474,8 +507,9 @@ class _ProcessBackend(_QueuedBackend):
         alive = sum(1 for w in self._pool if not w.retiring)
         for _ in range(self.workers - alive):
             parent_conn, child_conn = self._context.Pipe(duplex=True)
-            process = self._context.Process(target=_worker_main, args=(child_conn, self._spec),
-                                            name="leas-contact-worker", daemon=True)
+            process = self._context.Process(
+                target=_worker_main, args=(child_conn, self._spec), name="leas-contact-worker", daemon=True
+            )
             process.start()
             # Only the child keeps its end: then the parent sees EOF when it dies.
             child_conn.close()
@@ -530,29 +564,48 @@ class _ProcessBackend(_QueuedBackend):
         if not worker.ready and not worker.retiring:
             self._startup_deaths += 1
             if self._startup_deaths >= _MAX_STARTUP_DEATHS:
-                self._break(ValidationPoolError(
-                    f"{self._startup_deaths} contact workers died during start-up "
-                    f"(last {_describe_exit(worker.process.exitcode)})"))
+                self._break(
+                    ValidationPoolError(
+                        f"{self._startup_deaths} contact workers died during start-up "
+                        f"(last {_describe_exit(worker.process.exitcode)})"
+                    )
+                )
         if task is None:
             return
         pid = worker.pid if worker.pid is not None else worker.process.pid
         if worker.timed_out:
-            self._complete(task, PathResult(
-                index=task.index, coverage=0.0, last_valid_index=-1, plan=None,
-                error=f"TimeoutError: path {task.index} took longer than {self._task_timeout:g} s "
-                      f"(worker pid {pid} killed)",
-                attempts=task.attempts, seconds=time.monotonic() - worker.task_started))
+            self._complete(
+                task,
+                PathResult(
+                    index=task.index,
+                    coverage=0.0,
+                    last_valid_index=-1,
+                    plan=None,
+                    error=f"TimeoutError: path {task.index} took longer than {self._task_timeout:g} s "
+                    f"(worker pid {pid} killed)",
+                    attempts=task.attempts,
+                    seconds=time.monotonic() - worker.task_started,
+                ),
+            )
             return
         how = _describe_exit(worker.process.exitcode)
         if task.attempts < self._max_attempts:
             # Front of the queue: the retry should not wait behind later batches.
             self._queue.appendleft(task)
         else:
-            self._complete(task, PathResult(
-                index=task.index, coverage=0.0, last_valid_index=-1, plan=None,
-                error=f"WorkerDied: contact worker (pid {pid}) {how} while planning path "
-                      f"{task.index}, on each of {task.attempts} attempts",
-                attempts=task.attempts, seconds=time.monotonic() - worker.task_started))
+            self._complete(
+                task,
+                PathResult(
+                    index=task.index,
+                    coverage=0.0,
+                    last_valid_index=-1,
+                    plan=None,
+                    error=f"WorkerDied: contact worker (pid {pid}) {how} while planning path "
+                    f"{task.index}, on each of {task.attempts} attempts",
+                    attempts=task.attempts,
+                    seconds=time.monotonic() - worker.task_started,
+                ),
+            )
 
     def _check_timeouts(self) -> float:
         """Kill workers over the task timeout; return seconds until the next deadline."""
@@ -645,14 +698,17 @@ def _stop_workers(workers: list[_Worker]) -> None:
 BackendFactory = Callable[[str, WorkerSpec, "int | None", dict], Backend]
 _BACKENDS: dict[str, BackendFactory] = {}
 # Backends shipped with leas-jax: the module registers itself when imported, on first use.
-_BUILTIN_BACKENDS = {"ray": "leas_jax.contacts.ray_backend", "auto": "leas_jax.contacts.ray_backend",
-                     "local": "leas_jax.contacts.ray_backend"}
+_BUILTIN_BACKENDS = {
+    "ray": "leas_jax.contacts.validation.ray_backend",
+    "auto": "leas_jax.contacts.validation.ray_backend",
+    "local": "leas_jax.contacts.validation.ray_backend",
+}
 
 
 def register_backend(scheme: str, factory: BackendFactory) -> None:
     """Register the executor used for `ValidationPool(address="<scheme>://...")`.
 
-    The Ray backend (`leas_jax.contacts.ray_backend`, schemes "ray", "auto"
+    The Ray backend (`leas_jax.contacts.validation.ray_backend`, schemes "ray", "auto"
     and "local") is registered this way when first used; it is the example to
     follow for another executor.
 
@@ -689,11 +745,18 @@ def _terrain_spec(terrain, config, plan_fn, return_plans: bool) -> WorkerSpec:
         text, source = terrain, "<terrain text>"
         loads_terrain(text, source=source)
     else:
-        raise UsageError(f"terrain: expected a Terrain or the terrain file text, got {type(terrain).__name__}")
+        raise UsageError(
+            f"terrain: expected a Terrain or the terrain file text, got {type(terrain).__name__}"
+        )
     if plan_fn is not None and not callable(plan_fn):
         raise UsageError(f"plan_fn: expected a function, got {type(plan_fn).__name__}")
-    return WorkerSpec(terrain_text=text, terrain_source=source, config=config, plan_fn=plan_fn,
-                      return_plans=bool(return_plans))
+    return WorkerSpec(
+        terrain_text=text,
+        terrain_source=source,
+        config=config,
+        plan_fn=plan_fn,
+        return_plans=bool(return_plans),
+    )
 
 
 def _check_guides(guides, timestep) -> list[np.ndarray]:
@@ -702,8 +765,11 @@ def _check_guides(guides, timestep) -> list[np.ndarray]:
         guides = list(guides)
     if isinstance(guides, (str, bytes)) or not isinstance(guides, Sequence):
         raise UsageError(f"guides: expected a list of [T, 4] arrays, got {type(guides).__name__}")
-    if not (isinstance(timestep, (int, float, np.floating, np.integer))
-            and math.isfinite(float(timestep)) and float(timestep) > 0):
+    if not (
+        isinstance(timestep, (int, float, np.floating, np.integer))
+        and math.isfinite(float(timestep))
+        and float(timestep) > 0
+    ):
         raise UsageError(f"timestep: expected a positive number of seconds, got {timestep!r}")
     checked = []
     for i, guide in enumerate(guides):
@@ -734,7 +800,7 @@ class ValidationPool:
         plan_fn: None for `plan_contacts`; tests inject a picklable module-level
             function with the same signature (see module docstring).
         address: None for local processes; "ray://HOST:PORT", "auto" or
-            "local" for Ray actors (`leas_jax.contacts.ray_backend`); another
+            "local" for Ray actors (`leas_jax.contacts.validation.ray_backend`); another
             "scheme://..." for a backend registered with `register_backend`.
         task_timeout: s; a path running longer has its worker killed and is
             reported as an error. None: no limit.
@@ -747,20 +813,35 @@ class ValidationPool:
             coverage and last_valid_index travel back: what the trainer uses).
     """
 
-    def __init__(self, terrain, *, workers: int | None = None, config=None, plan_fn: Callable | None = None,
-                 address: str | None = None, task_timeout: float | None = DEFAULT_TASK_TIMEOUT,
-                 max_attempts: int = DEFAULT_MAX_ATTEMPTS, max_tasks_per_worker: int | None = None,
-                 start_method: str = "spawn", return_plans: bool = True):
-        if workers is not None and (not isinstance(workers, (int, np.integer)) or isinstance(workers, bool)
-                                    or workers < 0):
+    def __init__(
+        self,
+        terrain,
+        *,
+        workers: int | None = None,
+        config=None,
+        plan_fn: Callable | None = None,
+        address: str | None = None,
+        task_timeout: float | None = DEFAULT_TASK_TIMEOUT,
+        max_attempts: int = DEFAULT_MAX_ATTEMPTS,
+        max_tasks_per_worker: int | None = None,
+        start_method: str = "spawn",
+        return_plans: bool = True,
+    ):
+        if workers is not None and (
+            not isinstance(workers, (int, np.integer)) or isinstance(workers, bool) or workers < 0
+        ):
             raise UsageError(f"workers: expected an integer >= 0, got {workers!r}")
         if start_method not in ("spawn", "forkserver"):
-            raise UsageError(f"start_method: expected 'spawn' or 'forkserver', got {start_method!r} "
-                             "(fork is unsafe once JAX has started threads)")
+            raise UsageError(
+                f"start_method: expected 'spawn' or 'forkserver', got {start_method!r} "
+                "(fork is unsafe once JAX has started threads)"
+            )
         if not isinstance(max_attempts, int) or max_attempts < 1:
             raise UsageError(f"max_attempts: expected an integer >= 1, got {max_attempts!r}")
         if task_timeout is not None and not task_timeout > 0:
-            raise UsageError(f"task_timeout: expected a positive number of seconds or None, got {task_timeout!r}")
+            raise UsageError(
+                f"task_timeout: expected a positive number of seconds or None, got {task_timeout!r}"
+            )
         spec = _terrain_spec(terrain, config, plan_fn, return_plans)
         self._base_seed = int(getattr(config, "seed", 0) or 0)
         self._backend: Backend
@@ -770,18 +851,27 @@ class ValidationPool:
                 importlib.import_module(_BUILTIN_BACKENDS[scheme])
             factory = _BACKENDS.get(scheme)
             if factory is None:
-                raise UsageError(f"address={address!r}: no validation backend for scheme {scheme!r} (Ray: "
-                                 "ray://HOST:PORT, auto or local); see leas_jax.contacts.pool.register_backend")
-            options = dict(task_timeout=task_timeout, max_attempts=max_attempts,
-                           max_tasks_per_worker=max_tasks_per_worker)
+                raise UsageError(
+                    f"address={address!r}: no validation backend for scheme {scheme!r} (Ray: "
+                    "ray://HOST:PORT, auto or local); see leas_jax.contacts.validation.pool.register_backend"
+                )
+            options = dict(
+                task_timeout=task_timeout,
+                max_attempts=max_attempts,
+                max_tasks_per_worker=max_tasks_per_worker,
+            )
             self._backend = factory(address, spec, workers, options)
         elif workers == 0:
             self._backend = _InlineBackend(spec)
         else:
             self._backend = _ProcessBackend(
-                spec, _default_workers() if workers is None else int(workers), task_timeout=task_timeout,
-                max_attempts=max_attempts, max_tasks_per_worker=max_tasks_per_worker,
-                start_method=start_method)
+                spec,
+                _default_workers() if workers is None else int(workers),
+                task_timeout=task_timeout,
+                max_attempts=max_attempts,
+                max_tasks_per_worker=max_tasks_per_worker,
+                start_method=start_method,
+            )
         # Workers must not outlive an unclosed pool at interpreter exit.
         self._finalizer = weakref.finalize(self, self._backend.close, True)
 
@@ -808,7 +898,9 @@ class ValidationPool:
         seeds = [path_seed(self._base_seed, i) for i in range(len(checked))]
         return self._backend.submit(checked, float(timestep), seeds)
 
-    def map(self, guides: Sequence[np.ndarray], timestep: float, timeout: float | None = None) -> list[PathResult]:
+    def map(
+        self, guides: Sequence[np.ndarray], timestep: float, timeout: float | None = None
+    ) -> list[PathResult]:
         """Plan a batch and wait: `submit(guides, timestep).result(timeout)`."""
         return self.submit(guides, timestep).result(timeout)
 
@@ -826,10 +918,19 @@ class ValidationPool:
         self.close(cancel_pending=exc_type is not None)
 
 
-def validate_paths(terrain, guides: Sequence[np.ndarray], timestep: float, workers: int | None = None,
-                   config=None, *, plan_fn: Callable | None = None, address: str | None = None,
-                   task_timeout: float | None = DEFAULT_TASK_TIMEOUT,
-                   max_attempts: int = DEFAULT_MAX_ATTEMPTS, return_plans: bool = True) -> list[PathResult]:
+def validate_paths(
+    terrain,
+    guides: Sequence[np.ndarray],
+    timestep: float,
+    workers: int | None = None,
+    config=None,
+    *,
+    plan_fn: Callable | None = None,
+    address: str | None = None,
+    task_timeout: float | None = DEFAULT_TASK_TIMEOUT,
+    max_attempts: int = DEFAULT_MAX_ATTEMPTS,
+    return_plans: bool = True,
+) -> list[PathResult]:
     """Run the contact generator on every guide path, in parallel (host-only).
 
     One-shot form of `ValidationPool`: starts at most `len(guides)` workers,
@@ -854,7 +955,14 @@ def validate_paths(terrain, guides: Sequence[np.ndarray], timestep: float, worke
         workers = min(_default_workers(), len(checked))
     elif workers and address is None:
         workers = min(int(workers), len(checked))
-    with ValidationPool(terrain, workers=workers, config=config, plan_fn=plan_fn, address=address,
-                        task_timeout=task_timeout, max_attempts=max_attempts,
-                        return_plans=return_plans) as pool:
+    with ValidationPool(
+        terrain,
+        workers=workers,
+        config=config,
+        plan_fn=plan_fn,
+        address=address,
+        task_timeout=task_timeout,
+        max_attempts=max_attempts,
+        return_plans=return_plans,
+    ) as pool:
         return pool.map(checked, timestep)

@@ -1,6 +1,6 @@
 """Static equilibrium of a stance: hpp-centroidal-dynamics robustness LP and our own LP.
 
-Host-only, not jittable. DESIGN §6 check 4: the stance is in static equilibrium with
+Host-only, not jittable. docs/design.md §6 check 4: the stance is in static equilibrium with
 robustness >= 0 by the linear program of hpp-centroidal-dynamics over the sole
 corners (mu = 0.5). `sole_corners` gives those contact points; `HppEquilibrium` wraps
 the library; `static_equilibrium_lp` is an independent formulation with SciPy's
@@ -21,15 +21,21 @@ import sysconfig
 
 import numpy as np
 
-from leas_jax.contacts.model import FRICTION, SOLE_LENGTH, SOLE_WIDTH
+from leas_jax.contacts.robot.model import FRICTION, SOLE_LENGTH, SOLE_WIDTH
 
 GRAVITY = 9.81  # m/s^2, hpp-centroidal-dynamics' value (Equilibrium uses g = -9.81 e_z)
 # Friction-cone generators per contact point: hpp-centroidal-dynamics' usual choice
 # (its tests and the RB-PRM Talos scripts use 4), an inscribed pyramid of the cone.
 GENERATORS_PER_CONTACT = 4
 # Shared libraries of hpp-centroidal-dynamics and its dependencies, in load order.
-_HPP_LIBRARIES = ("libeigenpy.so", "libcdd.so.0", "libCoinUtils.so.3", "libClp.so.1",
-                  "libqpOASES.so.3.2", "libhpp-centroidal-dynamics.so")
+_HPP_LIBRARIES = (
+    "libeigenpy.so",
+    "libcdd.so.0",
+    "libCoinUtils.so.3",
+    "libClp.so.1",
+    "libqpOASES.so.3.2",
+    "libhpp-centroidal-dynamics.so",
+)
 
 
 def _cmeel_lib_dir() -> str:
@@ -47,9 +53,12 @@ def _cmeel_lib_dir() -> str:
         seen.append(path)
         if os.path.isfile(os.path.join(path, "libhpp-centroidal-dynamics.so")):
             return path
-    raise ImportError("hpp-centroidal-dynamics shared library not found; looked for "
-                      "libhpp-centroidal-dynamics.so in: " + ", ".join(dict.fromkeys(seen))
-                      + " (install the pinned `hpp-centroidal-dynamics` wheel: make venv)")
+    raise ImportError(
+        "hpp-centroidal-dynamics shared library not found; looked for "
+        "libhpp-centroidal-dynamics.so in: "
+        + ", ".join(dict.fromkeys(seen))
+        + " (install the pinned `hpp-centroidal-dynamics` wheel: make venv)"
+    )
 
 
 @functools.lru_cache(maxsize=1)
@@ -79,15 +88,16 @@ def sole_corners(feet: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         (points [4 C, 3], normals [4 C, 3]) world frame, for the C feet in contact;
         the normal of each corner is its sole's z axis.
     """
-    from leas_jax.contacts.model import matrix_from_quat_xyzw
+    from leas_jax.contacts.robot.model import matrix_from_quat_xyzw
 
     feet = np.asarray(feet, dtype=np.float64).reshape(-1, 7)
     feet = feet[~np.any(np.isnan(feet), axis=1)]
     if len(feet) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3))
     rot = matrix_from_quat_xyzw(feet[:, 3:])
-    half = np.array([[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0]
-                     for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))])
+    half = np.array(
+        [[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0] for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+    )
     points = feet[:, None, :3] + np.einsum("fij,cj->fci", rot, half)
     normals = np.broadcast_to(rot[:, None, :, 2], points.shape)
     return points.reshape(-1, 3), np.ascontiguousarray(normals.reshape(-1, 3))
@@ -120,8 +130,9 @@ class HppEquilibrium:
         key = (points.tobytes(), normals.tobytes())
         if key == self._contacts_key:
             return
-        if not self._eq.setNewContacts(points, normals, self.mu,
-                                       self._hpp.EquilibriumAlgorithm.EQUILIBRIUM_ALGORITHM_LP):
+        if not self._eq.setNewContacts(
+            points, normals, self.mu, self._hpp.EquilibriumAlgorithm.EQUILIBRIUM_ALGORITHM_LP
+        ):
             raise RuntimeError("hpp-centroidal-dynamics rejected the contact set")
         self._contacts_key = key
 
@@ -196,8 +207,9 @@ def flat_support_margin(points: np.ndarray, normals: np.ndarray, com: np.ndarray
     return float(dist.min())
 
 
-def friction_generators(normals: np.ndarray, mu: float = FRICTION,
-                        count: int = GENERATORS_PER_CONTACT) -> np.ndarray:
+def friction_generators(
+    normals: np.ndarray, mu: float = FRICTION, count: int = GENERATORS_PER_CONTACT
+) -> np.ndarray:
     """Edges of the friction pyramids inscribed in the cones at each contact.
 
     Same pyramid as hpp-centroidal-dynamics (`Equilibrium::computeGenerators`), so
@@ -220,8 +232,9 @@ def friction_generators(normals: np.ndarray, mu: float = FRICTION,
     t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
     t2 /= np.linalg.norm(t2, axis=1, keepdims=True)
     angles = np.pi / 4 + 2.0 * np.pi * np.arange(count) / count
-    edges = (normals[:, None, :] + mu * (np.sin(angles)[None, :, None] * t1[:, None, :]
-                                         + np.cos(angles)[None, :, None] * t2[:, None, :]))
+    edges = normals[:, None, :] + mu * (
+        np.sin(angles)[None, :, None] * t1[:, None, :] + np.cos(angles)[None, :, None] * t2[:, None, :]
+    )
     return edges / np.linalg.norm(edges, axis=2, keepdims=True)
 
 
@@ -236,8 +249,14 @@ def robustness_scale(mu: float = FRICTION, count: int = GENERATORS_PER_CONTACT) 
     return float(np.linalg.norm(np.cross(edges.sum(axis=0), edges[0])))
 
 
-def static_equilibrium_lp(points: np.ndarray, normals: np.ndarray, com: np.ndarray, mass: float,
-                          mu: float = FRICTION, count: int = GENERATORS_PER_CONTACT) -> float:
+def static_equilibrium_lp(
+    points: np.ndarray,
+    normals: np.ndarray,
+    com: np.ndarray,
+    mass: float,
+    mu: float = FRICTION,
+    count: int = GENERATORS_PER_CONTACT,
+) -> float:
     """Independent robustness LP with SciPy (slow; for cross-checks and tests).
 
     Static equilibrium of a body of mass m at CoM c under gravity g = -9.81 e_z with
@@ -250,7 +269,7 @@ def static_equilibrium_lp(points: np.ndarray, normals: np.ndarray, com: np.ndarr
     s_ik >= 0 this is a standard-form LP. The robustness is b0* times
     `robustness_scale`: the definition of hpp-centroidal-dynamics' LP algorithm, so
     the values match up to solver tolerance; the sign (equilibrium or not) is what
-    DESIGN §6 check 4 uses.
+    docs/design.md §6 check 4 uses.
 
     Args:
         points: [N, 3] contact points, world frame.

@@ -146,6 +146,14 @@ class EnvConfig:
     # gave 89.1 % once and 0.12 m slowed them to 0.13 m/s (README, "Training")
     clearance_margin: float = 0.10
     reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
+    # Termination condition (issue 19): "cylinders", the paper's reachability condition with
+    # `reachability`'s cylinders and terms, or "learned", the network of
+    # `leas_jax.env.learned_feasibility` trained on the contact generator's walking verdicts
+    # (benchmarks/feasibility_condition.py), with its weights in `learned_weights` (an .npz,
+    # relative to the repository root unless it exists as given). The spawn points stay those
+    # of the cylinders in both cases (a fallback that is valid for every yaw).
+    condition: str = "cylinders"
+    learned_weights: str = "checkpoints/feasibility/walking.npz"
     reachability: ReachabilityConfig = field(default_factory=ReachabilityConfig)
     heightmap: HeightmapConfig = field(default_factory=HeightmapConfig)
     rewards: RewardWeights = field(default_factory=RewardWeights)

@@ -1,7 +1,7 @@
 """`LeasEnv`: the LeaS MDP as a Brax environment (one env, no batch axis).
 
 The env composes the pure functions of `kinematics`, `heightmap`,
-`reachability` and `reward`. Its terrain is a `Heightfield` pytree held as
+`condition` (reachability) and `reward`. Its terrain is a `Heightfield` pytree held as
 data: build the env inside a jitted function from a traced field
 (`env.with_field(field)`) to keep the rasters out of the compiled constants.
 """
@@ -20,7 +20,7 @@ from flax import struct
 with contextlib.redirect_stdout(io.StringIO()):
     from brax.envs.base import Env, State
 
-from leas_jax.env import heightmap, kinematics, reachability, reward
+from leas_jax.env import condition, heightmap, kinematics, reward
 from leas_jax.env.config import EnvConfig
 from leas_jax.env.field import Heightfield, sample_bilinear
 
@@ -69,7 +69,7 @@ class LeasEnv(Env):
     Observation [81]: root-frame velocity [3], target angle [1] (target
     direction minus heading, wrapped to [-pi, pi)), heightmap [77].
     Action [4]: (a_x, a_y, a_z, omega) in [-1, 1].
-    Episodes end on an invalid pose (reachability), after `episode_length`
+    Episodes end on an invalid pose (`condition.valid`: the cylinders or the learned condition), after `episode_length`
     steps (info['truncation'] = 1), and with `stop_at_target` when the root is
     within `target_reached_distance` of the target point.
     """
@@ -152,7 +152,7 @@ class LeasEnv(Env):
         yaw = (2.0 * cand[:, 3] - 1.0) * jnp.pi
         z = sample_bilinear(self.field, xy) + cfg.nominal_root_height
         poses = jnp.concatenate([xy, z[:, None], yaw[:, None]], axis=1)
-        ok = jax.vmap(lambda p: reachability.valid(self.field, p, cfg.reachability))(poses)
+        ok = jax.vmap(lambda p: condition.valid(self.field, p, cfg))(poses)
         ok = ok | last  # spawn points are valid for every yaw by construction
         pose = poses[jnp.argmax(ok)]
         target_angle = (2.0 * target_u - 1.0) * jnp.pi
@@ -222,9 +222,9 @@ class LeasEnv(Env):
         root = root.replace(pos=pos, vel=vel, yaw=yaw, target_dir=target_dir, steps=steps)
 
         terms = reward.terms(vel, yaw, action, target_dir, cfg)
-        ok = reachability.valid(self.field, root.pose, cfg.reachability)
+        ok = condition.valid(self.field, root.pose, cfg)
         terms["clearance"] = (
-            -reachability.clearance_shortfall(self.field, root.pose, cfg.clearance_margin, cfg.reachability)
+            -condition.clearance_shortfall(self.field, root.pose, cfg.clearance_margin, cfg)
             if cfg.rewards.clearance != 0.0
             else jnp.zeros(())
         )

@@ -11,6 +11,8 @@ terrain is `void_height` (the void the boxes stand over).
 
 from __future__ import annotations
 
+import dataclasses
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -42,6 +44,9 @@ class Heightfield:
         spawn_xy: [S, 2] world (x, y) of grid points where a root at nominal
             height is valid for every yaw; resets draw around them.
         spawn_spacing: [] spacing of the spawn candidates (m); resets jitter within it.
+        condition: the learned feasibility condition's parameters
+            (`learned_feasibility.LearnedParams`) when `EnvConfig.condition` is "learned",
+            else {} (no leaves).
     """
 
     heights: jax.Array
@@ -55,6 +60,7 @@ class Heightfield:
     void_height: jax.Array
     spawn_xy: jax.Array
     spawn_spacing: jax.Array
+    condition: dict = struct.field(default_factory=dict)
 
 
 def _grid_index(field: Heightfield, xy: jax.Array):
@@ -291,7 +297,29 @@ def heightfield_from_raster(
         void_height=f32(void_height),
         spawn_xy=f32(spawn_xy),
         spawn_spacing=f32(spawn_spacing),
+        condition=_condition_params(config),
     )
+
+
+def _condition_params(config: EnvConfig) -> dict:
+    """The learned condition's parameters when `config.condition` is "learned", else {} (host)."""
+    if config.condition == "cylinders":
+        return {}
+    if config.condition != "learned":
+        raise ValueError(f"EnvConfig.condition must be 'cylinders' or 'learned', got {config.condition!r}")
+    import json
+
+    from leas_jax.env.learned_feasibility import load_params, resolve_weights
+
+    path = resolve_weights(config.learned_weights)
+    params, metadata = load_params(path)
+    fitted = metadata.get("reachability")
+    if fitted is not None and json.loads(fitted) != dataclasses.asdict(config.reachability):
+        raise ValueError(
+            f"{path}: the learned condition was fitted on the margins of another ReachabilityConfig "
+            f"({fitted}); build the env with that EnvConfig.reachability"
+        )
+    return params
 
 
 def heightfield_from_terrain(

@@ -30,6 +30,9 @@ benchmarks/reachability_false_positives.py for the false positives they target):
     `Heightfield.hand_max`).
 Disk maxima and minima are precomputed rasters (`Heightfield`), so the test
 costs three gathers per leg pair (and one more per leg for the foothold).
+`margins` gives the same quantities as signed distances to their thresholds (the learned
+condition of `learned_feasibility` reads them); `leas_jax.env.condition` selects the
+environment's termination condition (these cylinders or the learned one).
 """
 
 import dataclasses
@@ -139,14 +142,52 @@ def valid(
     return jnp.all(jnp.stack(list(terms(field, pose, config).values())))
 
 
+MARGIN_CLIP = 1.0  # m, |margin| kept (an infinite raster value, e.g. no solid ground, reads as 1 m)
+
+
+def margins(
+    field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()
+) -> jax.Array:
+    """How far each test of `terms` is from its threshold, positive when it holds (m, clipped to
+    +-MARGIN_CLIP). pose: [4] (x, y, z, yaw), world -> [M].
+
+    Order: trunk (z + trunk_bottom - trunk_max); for each leg of `all_leg_centers` (L = 2 or 4),
+    leg_max - (z + leg_bottom), then for each, (z + leg_top) - leg_min; with the foothold term,
+    foothold_spread - foothold per leg; with the hands term, z + hand_bottom - hand_max per hand.
+    M = 1 + 2 L (+ L) (+ 2). `valid` holds iff every margin is > 0 or, for the legs and the
+    foothold, >= 0.
+    """
+    z = pose[2]
+    legs = all_leg_centers(pose, config)
+    parts = [
+        (z + config.trunk_bottom - sample_nearest(field, field.trunk_max, pose[:2]))[None],
+        sample_nearest(field, field.leg_max, legs, outside=-jnp.inf) - (z + config.leg_bottom),
+        (z + config.leg_top) - sample_nearest(field, field.leg_min, legs, outside=jnp.inf),
+    ]
+    if config.foothold_spread is not None:
+        foothold = _term_raster(field, field.foothold, "foothold")
+        parts.append(config.foothold_spread - sample_nearest(field, foothold, legs, outside=jnp.inf))
+    if config.hand_radius is not None:
+        hand = _term_raster(field, field.hand_max, "hand")
+        parts.append(
+            z + config.hand_bottom - sample_nearest(field, hand, hand_centers(pose, config), outside=-jnp.inf)
+        )
+    return jnp.clip(jnp.concatenate(parts), -MARGIN_CLIP, MARGIN_CLIP)
+
+
+def shifted_poses(pose: jax.Array, margin: float) -> jax.Array:
+    """The six poses shifted by `margin` (m) along the root frame's x, y and z axes, both ways.
+    pose: [4] (x, y, z, yaw), world -> [6, 4]."""
+    shifts = margin * jnp.concatenate([jnp.eye(3), -jnp.eye(3)])  # [6, 3], root frame
+    world = jnp.concatenate([rotate_z(shifts[:, :2], pose[3]), shifts[:, 2:]], axis=1)
+    return pose + jnp.concatenate([world, jnp.zeros((6, 1))], axis=1)
+
+
 def clearance_shortfall(
     field: Heightfield, pose: jax.Array, margin: float, config: ReachabilityConfig = ReachabilityConfig()
 ) -> jax.Array:
     """Fraction of the six poses shifted by `margin` (m) along the root frame's x, y and z
     axes, both ways, that violate the condition: 0 when the pose keeps `margin` of room in
     every direction, up to 1. pose: [4] (x, y, z, yaw), world -> float[]."""
-    shifts = margin * jnp.concatenate([jnp.eye(3), -jnp.eye(3)])  # [6, 3], root frame
-    world = jnp.concatenate([rotate_z(shifts[:, :2], pose[3]), shifts[:, 2:]], axis=1)
-    probes = pose + jnp.concatenate([world, jnp.zeros((6, 1))], axis=1)
-    ok = jax.vmap(lambda probe: valid(field, probe, config))(probes)
+    ok = jax.vmap(lambda probe: valid(field, probe, config))(shifted_poses(pose, margin))
     return 1.0 - ok.mean()

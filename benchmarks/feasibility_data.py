@@ -1,0 +1,185 @@
+"""Training and validation data of the learned feasibility condition (`leas_jax.feasibility`).
+
+A pose's label is the contact generator's *walking truth*
+(benchmarks/reachability_calibration.py): the generator covers the 0.36 m straight guide
+that starts at the pose along its yaw. Two pose sets:
+
+* fresh poses: `reachability_calibration.sample_poses` on the arena (uniform and near
+  obstacles, z over the generator's whole range);
+* policy poses: poses on the guides a policy draws on the arena from the env's own random
+  resets (`leas_jax.eval.geometric.arena_episodes`, deterministic policy): where the
+  condition matters.
+
+Labels are cached in .cache/feasibility_<set>_<key>.npz at the repository root, where
+<key> hashes everything a label depends on (`dataset_key`): the terrain file's text,
+the generator's settings (`GeneratorConfig`), the generator's sources
+(leas_jax/contacts/**/*.py) and the walking truth's guide. A change to any of them gives
+another key, so the labels are rebuilt. Labels are computed in chunks and the cache is
+rewritten (atomically) after each one: an interrupted build resumes where it stopped.
+Host-only.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import multiprocessing
+import os
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import reachability_calibration as rc  # noqa: E402
+
+REPO = rc.REPO
+CACHE = REPO / ".cache"
+CHUNK = 50  # poses per labelling task: a cache write every CHUNK * workers poses
+
+
+def dataset_key(
+    terrain_text: str, generator_config, sources_root: Path = REPO / "leas_jax" / "contacts"
+) -> str:
+    """sha256 (hex) of what a walking-truth label depends on.
+
+    Args:
+        terrain_text: the terrain file's text.
+        generator_config: the `GeneratorConfig` the labels are made with (its repr holds every field).
+        sources_root: the generator's package; every .py file below it is hashed (name and bytes).
+    """
+    digest = hashlib.sha256()
+    digest.update(f"walking {rc.WALK_POSES} {rc.WALK_SPEED} {rc.WALK_TIMESTEP}\n".encode())
+    digest.update(repr(generator_config).encode())
+    digest.update(terrain_text.encode())
+    for path in sorted(sources_root.rglob("*.py")):
+        digest.update(str(path.relative_to(sources_root)).encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def cache_file(name: str, key: str, cache: Path = CACHE) -> Path:
+    """.cache/feasibility_<name>_<first 16 hex digits of key>.npz."""
+    return cache / f"feasibility_{name}_{key[:16]}.npz"
+
+
+def _atomic_savez(path: Path, **arrays) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
+    np.savez_compressed(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def load_partial(path: Path, poses: np.ndarray, key: str) -> np.ndarray:
+    """Labels cached in `path` for a prefix of `poses` [N, 4] under `key`: bool [k], k <= N
+    (empty when the file is missing, holds other poses or another key)."""
+    if not path.is_file():
+        return np.zeros(0, bool)
+    with np.load(path) as data:
+        if str(data["key"]) != key:
+            print(f"not reusing {path}: the generator or the terrain changed")
+            return np.zeros(0, bool)
+        done = int(data["done"])
+        if data["poses"].shape != poses.shape or not np.array_equal(data["poses"], poses):
+            print(f"not reusing {path}: other poses")
+            return np.zeros(0, bool)
+        return np.asarray(data["labels"][:done], bool)
+
+
+def cached_labels(
+    poses: np.ndarray,
+    key: str,
+    path: Path,
+    label_chunks: Callable[[list[np.ndarray]], object],
+    chunk: int = CHUNK,
+) -> np.ndarray:
+    """Labels of poses [N, 4], from the cache where it has them, the rest computed and cached.
+
+    Args:
+        poses: [N, 4] (x, y, z, yaw), world.
+        key: `dataset_key` of the labeller.
+        path: the cache file.
+        label_chunks: maps a list of pose chunks to an iterable of bool label arrays, in order
+            (a pool's imap, or a plain map in tests).
+        chunk: poses per chunk.
+
+    Returns:
+        bool [N]. The cache holds poses, labels, the number done and the key after every chunk.
+    """
+    poses = np.asarray(poses, np.float64)
+    labels = np.zeros(len(poses), bool)
+    done = len(known := load_partial(path, poses, key))
+    labels[:done] = known
+    if done < len(poses):
+        starts = range(done, len(poses), chunk)
+        began = time.perf_counter()
+        for start, part in zip(starts, label_chunks([poses[s : s + chunk] for s in starts]), strict=True):
+            labels[start : start + len(part)] = part
+            done = start + len(part)
+            _atomic_savez(path, poses=poses, labels=labels, done=done, key=key)
+            rate = (done - starts[0]) / (time.perf_counter() - began)
+            print(f"  {path.name}: {done} / {len(poses)} poses labelled ({rate:.2f} poses/s)", flush=True)
+    return labels
+
+
+_WORKER = {}
+
+
+def _init_worker(terrain_text: str, generator_config) -> None:
+    from leas_jax.contacts.planner.generator import ContactGenerator
+    from leas_jax.terrain import loads_terrain
+
+    _WORKER["generator"] = ContactGenerator(
+        loads_terrain(terrain_text, source="<feasibility>"), generator_config
+    )
+
+
+def _walking_labels(poses: np.ndarray) -> np.ndarray:
+    generator = _WORKER["generator"]
+    return np.array(
+        [generator.plan(rc.walking_guide(p), rc.WALK_TIMESTEP).coverage >= 1.0 for p in poses], dtype=bool
+    )
+
+
+def walking_labels(
+    terrain, poses: np.ndarray, name: str, workers: int = 2, generator_config=None
+) -> np.ndarray:
+    """The generator's walking truth at poses [N, 4] (bool [N]), cached as `cache_file(name, key)`.
+
+    Host-only: `workers` spawn processes (0 or 1: this process), one ContactGenerator each.
+    """
+    from leas_jax.contacts.planner.generator import GeneratorConfig
+
+    generator_config = GeneratorConfig() if generator_config is None else generator_config
+    key = dataset_key(terrain.text, generator_config)
+    path = cache_file(name, key)
+    if workers <= 1:
+        _init_worker(terrain.text, generator_config)
+        return cached_labels(poses, key, path, lambda chunks: map(_walking_labels, chunks))
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(workers, initializer=_init_worker, initargs=(terrain.text, generator_config)) as pool:
+        return cached_labels(poses, key, path, lambda chunks: pool.imap(_walking_labels, chunks))
+
+
+def fresh_poses(terrain, count: int, seed: int) -> np.ndarray:
+    """[count, 4] fresh poses (`reachability_calibration.sample_poses`)."""
+    return rc.sample_poses(terrain, count, seed)
+
+
+def policy_poses(policy, terrain, count: int, seed: int, per_guide: int = 4, steps: int = 400) -> np.ndarray:
+    """[count, 4] poses on a policy's own arena guides (deterministic policy, env resets, seeded).
+
+    `count / per_guide` episodes (`arena_episodes`); `per_guide` poses drawn uniformly
+    (seeded) among each guide's valid poses.
+    """
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.eval.geometric import arena_episodes
+
+    n = -(-count // per_guide)
+    field = heightfield_from_terrain(terrain, policy.config.env)
+    episodes = arena_episodes(policy, field, n=n, seed=seed, steps=steps)
+    rng = np.random.default_rng(seed)
+    picks = [episodes.poses[k, rng.integers(0, episodes.lengths[k], per_guide)] for k in range(n)]
+    return np.concatenate(picks)[:count].astype(np.float64)

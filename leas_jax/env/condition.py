@@ -1,0 +1,38 @@
+"""The environment's termination condition, selected by `EnvConfig.condition`. Pure, jittable.
+
+"cylinders": the paper's reachability condition (`reachability.valid` with
+`EnvConfig.reachability`); "learned": the network of `learned_feasibility`, trained on the
+contact generator's walking verdicts, whose parameters the heightfield carries
+(`Heightfield.condition`, loaded by `heightfield_from_terrain` from `EnvConfig.learned_weights`).
+"""
+
+import jax
+
+from leas_jax.env import learned_feasibility, reachability
+from leas_jax.env.config import EnvConfig
+from leas_jax.env.field import Heightfield
+
+CONDITIONS = ("cylinders", "learned")
+
+
+def valid(field: Heightfield, pose: jax.Array, config: EnvConfig) -> jax.Array:
+    """True when the pose passes the selected condition. pose: [4] (x, y, z, yaw), world -> bool[]."""
+    if config.condition == "learned":
+        if not field.condition:
+            raise ValueError(
+                "EnvConfig.condition is 'learned' but the heightfield has no learned condition: "
+                "build it with the same EnvConfig"
+            )
+        return learned_feasibility.valid(field.condition, field, pose, config.reachability)
+    if config.condition != "cylinders":
+        raise ValueError(
+            f"EnvConfig.condition must be one of {', '.join(CONDITIONS)}, got {config.condition!r}"
+        )
+    return reachability.valid(field, pose, config.reachability)
+
+
+def clearance_shortfall(field: Heightfield, pose: jax.Array, margin: float, config: EnvConfig) -> jax.Array:
+    """`reachability.clearance_shortfall` under the selected condition: the fraction of the six
+    poses shifted by `margin` (m) along the root frame's axes that fail it. pose: [4] -> float[]."""
+    probes = reachability.shifted_poses(pose, margin)
+    return 1.0 - jax.vmap(lambda probe: valid(field, probe, config))(probes).mean()

@@ -1,0 +1,75 @@
+"""benchmarks/feasibility_data.py: the labels' cache key and its invalidation, resuming a build."""
+
+import dataclasses
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from leas_jax.contacts.planner.generator import GeneratorConfig
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+import feasibility_data as fd  # noqa: E402
+
+TERRAIN = (Path(__file__).parent / "data" / "slab_with_wall.toml").read_text()
+
+
+def test_key_changes_with_the_generator_config_the_terrain_and_the_sources(tmp_path):
+    base = fd.dataset_key(TERRAIN, GeneratorConfig())
+    assert fd.dataset_key(TERRAIN, GeneratorConfig()) == base
+    assert fd.dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), step_trigger=0.08)) != base
+    assert fd.dataset_key(TERRAIN + "\n# edited\n", GeneratorConfig()) != base
+    sources = tmp_path / "contacts" / "planner"
+    sources.mkdir(parents=True)
+    (sources / "generator.py").write_text("x = 1\n")
+    first = fd.dataset_key(TERRAIN, GeneratorConfig(), tmp_path / "contacts")
+    (sources / "generator.py").write_text("x = 2\n")  # a sub-package's source counts too
+    assert fd.dataset_key(TERRAIN, GeneratorConfig(), tmp_path / "contacts") != first
+
+
+class Labeller:
+    """Labels a pose feasible when its x > 0; counts the poses it labelled; fails after `fail_after` chunks."""
+
+    def __init__(self, fail_after=None):
+        self.poses, self.fail_after, self.chunks = 0, fail_after, 0
+
+    def __call__(self, chunks):
+        for chunk in chunks:
+            if self.fail_after is not None and self.chunks >= self.fail_after:
+                raise KeyboardInterrupt
+            self.chunks += 1
+            self.poses += len(chunk)
+            yield chunk[:, 0] > 0
+
+
+def test_cache_reused_rebuilt_when_the_key_changes_and_resumed(tmp_path):
+    poses = np.random.default_rng(0).normal(size=(25, 4))
+    path = tmp_path / "labels.npz"
+    key = fd.dataset_key(TERRAIN, GeneratorConfig())
+    first = Labeller()
+    labels = fd.cached_labels(poses, key, path, first, chunk=10)
+    np.testing.assert_array_equal(labels, poses[:, 0] > 0)
+    assert first.poses == 25
+    again = Labeller()
+    np.testing.assert_array_equal(fd.cached_labels(poses, key, path, again, chunk=10), labels)
+    assert again.poses == 0  # from the cache
+    other_key = fd.dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), max_candidates=8))
+    rebuilt = Labeller()
+    fd.cached_labels(poses, other_key, path, rebuilt, chunk=10)
+    assert rebuilt.poses == 25  # the generator config changed: every label recomputed
+    other_poses = Labeller()
+    fd.cached_labels(poses + 1.0, other_key, path, other_poses, chunk=10)
+    assert other_poses.poses == 25
+    # an interrupted build keeps its finished chunks and resumes after them
+    resumed_path = tmp_path / "resumed.npz"
+    with pytest.raises(KeyboardInterrupt):
+        fd.cached_labels(poses, key, resumed_path, Labeller(fail_after=2), chunk=10)
+    assert len(fd.load_partial(resumed_path, poses, key)) == 20
+    rest = Labeller()
+    np.testing.assert_array_equal(fd.cached_labels(poses, key, resumed_path, rest, chunk=10), labels)
+    assert rest.poses == 5
+
+
+def test_cache_file_names_hold_the_key():
+    assert fd.cache_file("fresh10_seed1", "ab" * 32).name == f"feasibility_fresh10_seed1_{'ab' * 8}.npz"

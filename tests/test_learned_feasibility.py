@@ -1,0 +1,165 @@
+"""The learned feasibility condition: shapes, jit and vmap, determinism, a known rule learned
+from synthetic data, the weights file, its selection as the env's termination condition."""
+
+import dataclasses
+import json
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from leas_jax.env import EnvConfig, LeasEnv, condition, heightfield_from_terrain, reachability
+from leas_jax.env import learned_feasibility as lf
+from leas_jax.feasibility import FitConfig, features_of, fit, predict
+from leas_jax.feasibility.fit import balanced_weights, mirrored, threshold_for
+from leas_jax.terrain import load_terrain
+from leas_jax.training.config import TRAINING_ENV
+
+WALL = load_terrain(Path(__file__).parent / "data" / "slab_with_wall.toml")  # ground 0, wall x 4.3-4.7, y 1-5
+FIELD = heightfield_from_terrain(WALL, TRAINING_ENV)
+SMALL = FitConfig(hidden=(16, 8), steps=400, learning_rate=1e-2)
+
+
+def _poses(n, seed=0):
+    """Poses over the slab, near the wall half of the time, z 0.6-1.3 m, any yaw."""
+    rng = np.random.default_rng(seed)
+    x = np.where(rng.random(n) < 0.5, rng.uniform(0.8, 5.2, n), rng.uniform(3.6, 5.2, n))
+    return np.column_stack(
+        [x, rng.uniform(0.8, 5.2, n), rng.uniform(0.6, 1.3, n), rng.uniform(-np.pi, np.pi, n)]
+    )
+
+
+def test_grid_and_feature_shapes():
+    grid = lf.patch_grid()
+    assert grid.shape == (14 * 17, 2)  # x -0.40..0.64, y -0.64..0.64 at 0.08 m
+    reach = TRAINING_ENV.reachability  # two legs, no foothold or hands: M = 1 + 2 * 2
+    assert lf.margin_count(reach) == 5 and lf.margin_count(EnvConfig().reachability) == 15
+    params = lf.init_params(jax.random.PRNGKey(0), reach=reach)
+    assert params["w0"].shape == (len(grid) + 1 + 5, 64)
+    x = np.asarray(lf.features(params, FIELD, jnp.array([2.0, 3.0, 1.0, 0.3]), reach))
+    assert x.shape == (len(grid) + 1 + 5,)
+    # flat ground 1.0 m under the root: every relative height -1.0, 1.0 m above the local ground
+    np.testing.assert_allclose(x[: len(grid)], -1.0, atol=1e-5)
+    assert x[len(grid)] == pytest.approx(1.0, abs=1e-5)
+    # margins: trunk 1.0 - 0.825 m, legs reach 1.175 - 1.0 below and 1.0 - 0.55 above the ground
+    np.testing.assert_allclose(x[len(grid) + 1 :], [0.175, 0.175, 0.175, 0.45, 0.45], atol=1e-5)
+    assert lf.logit(params, FIELD, jnp.zeros(4), reach).shape == ()
+    assert lf.valid(params, FIELD, jnp.zeros(4), reach).dtype == jnp.bool_
+
+
+def test_patch_turns_with_the_yaw():
+    """The wall 0.5 m ahead of the root (x 4.3) shows at root-frame x 0.48-0.56 when facing +x,
+    and behind-free when the root faces -x."""
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(0), reach=reach)
+    grid = np.asarray(params["grid"])
+    ahead = (np.abs(grid[:, 0] - 0.56) < 1e-4) & (np.abs(grid[:, 1]) < 1e-4)
+    facing = np.asarray(lf.features(params, FIELD, jnp.array([3.8, 3.0, 1.0, 0.0]), reach))
+    away = np.asarray(lf.features(params, FIELD, jnp.array([3.8, 3.0, 1.0, np.pi]), reach))
+    assert facing[: len(grid)][ahead][0] == pytest.approx(0.4)  # the wall top 1.5 m, clipped at +0.4
+    assert away[: len(grid)][ahead][0] == pytest.approx(-1.0, abs=1e-5)
+
+
+def test_mirror_index_is_an_involution():
+    grid = lf.patch_grid()
+    index = lf.mirror_index(grid)
+    np.testing.assert_array_equal(index[index], np.arange(len(grid)))
+    np.testing.assert_allclose(grid[index], grid * np.array([1.0, -1.0]), atol=1e-6)
+    # the features of a pose beside the wall and of its mirror image across the wall's axis (y 3)
+    field = heightfield_from_terrain(WALL, EnvConfig())  # every term: four legs, foothold, hands
+    reach = EnvConfig().reachability
+    params = lf.init_params(jax.random.PRNGKey(0), reach=reach)
+    full = lf.feature_mirror_index(grid, reach)
+    np.testing.assert_array_equal(full[full], np.arange(len(full)))
+    left = np.asarray(lf.features(params, field, jnp.array([3.9, 1.3, 1.0, 0.4]), reach))
+    right = np.asarray(lf.features(params, field, jnp.array([3.9, 4.7, 1.0, -0.4]), reach))
+    np.testing.assert_allclose(left[full], right, atol=0.03)
+    with pytest.raises(ValueError, match="symmetric"):
+        lf.mirror_index(lf.patch_grid(y_range=(-0.64, 0.56)))
+
+
+def test_jit_and_vmap_agree_with_single_calls():
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(1), reach=reach)
+    poses = jnp.asarray(_poses(16), jnp.float32)
+    batched = jax.jit(jax.vmap(lambda p: lf.logit(params, FIELD, p, reach)))(poses)
+    single = np.array([float(lf.logit(params, FIELD, p, reach)) for p in poses])
+    np.testing.assert_allclose(np.asarray(batched), single, rtol=1e-5, atol=1e-5)
+
+
+def test_threshold_keeps_the_target_share_of_feasible_poses():
+    logits = np.arange(100, dtype=float)
+    y = np.ones(100, bool)
+    t = threshold_for(logits, y, 0.95)
+    assert (logits >= t).mean() == pytest.approx(0.95)
+    with pytest.raises(ValueError, match="no feasible"):
+        threshold_for(logits, np.zeros(100, bool), 0.95)
+    w = balanced_weights(np.array([True, False, False, False]))
+    assert w[0] == pytest.approx(3 * w[1]) and w.sum() == pytest.approx(4.0)
+
+
+def test_learns_the_cylinders_from_synthetic_labels_and_is_deterministic():
+    """A known rule: the training presets' cylinders on the slab and its wall. Learned from
+    2 400 poses, it must agree with the rule on 800 held-out ones (>= 90 %, the cylinders are a
+    sharp function of the patch); the same data and seed give the same weights."""
+    rule = jax.jit(jax.vmap(lambda p: reachability.valid(FIELD, p, TRAINING_ENV.reachability)))
+    poses = _poses(3200, seed=3)
+    labels = np.asarray(rule(jnp.asarray(poses, jnp.float32)))
+    assert 0.2 < labels.mean() < 0.8  # both classes present
+    reach = TRAINING_ENV.reachability
+    x = features_of(lf.init_params(jax.random.PRNGKey(0), reach=reach), FIELD, poses, reach)
+    params, info = fit(x[:2400], labels[:2400], SMALL, reach=reach)
+    agreement = (predict(params, x[2400:]) == labels[2400:]).mean()
+    assert agreement >= 0.90, agreement
+    again, _ = fit(x[:2400], labels[:2400], SMALL, reach=reach)
+    for k in lf.LAYER_KEYS:
+        np.testing.assert_array_equal(np.asarray(params[k]), np.asarray(again[k]))
+    assert info["poses"] == 2400 and info["aside"] == 360
+    # the mirrored features of the mirrored terrain: a flat slab is its own mirror image
+    flat = x[np.abs(poses[:, 0] - 2.0) < 0.5][:5]
+    np.testing.assert_allclose(mirrored(flat, np.asarray(params["grid"]), reach), flat, atol=1e-5)
+
+
+def test_weights_round_trip_and_bad_files(tmp_path):
+    params = lf.init_params(jax.random.PRNGKey(2), hidden=(8, 4))
+    path = lf.save_params(tmp_path / "w.npz", params, data_key="abc")
+    loaded, meta = lf.load_params(path)
+    assert meta == {"data_key": "abc"}
+    for k, v in params.items():
+        np.testing.assert_array_equal(np.asarray(loaded[k]), np.asarray(v))
+    np.savez(tmp_path / "bad.npz", grid=np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="bad.npz.*missing"):
+        lf.load_params(tmp_path / "bad.npz")
+    with pytest.raises(ValueError, match="nope.npz"):
+        lf.load_params(tmp_path / "nope.npz")
+
+
+def test_env_selects_the_learned_condition(tmp_path):
+    """condition "learned": the field carries the weights, the env terminates where the network
+    says so (a network whose threshold rejects everything ends every episode at its first step)."""
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=TRAINING_ENV.reachability)
+    accept = lf.save_params(tmp_path / "accept.npz", {**params, "threshold": jnp.asarray(-1e9)})
+    reject = lf.save_params(tmp_path / "reject.npz", {**params, "threshold": jnp.asarray(1e9)})
+    done = {}
+    for name, path in (("accept", accept), ("reject", reject)):
+        config = dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(path))
+        field = heightfield_from_terrain(WALL, config)
+        assert set(field.condition) >= {"grid", "w0", "threshold"}
+        env = LeasEnv(field, config)
+        state = jax.jit(env.reset)(jax.random.PRNGKey(0))
+        done[name] = float(jax.jit(env.step)(state, jnp.zeros(4)).done)
+    assert done == {"accept": 0.0, "reject": 1.0}
+    assert heightfield_from_terrain(WALL, TRAINING_ENV).condition == {}
+    with pytest.raises(ValueError, match="condition must be"):
+        heightfield_from_terrain(WALL, dataclasses.replace(TRAINING_ENV, condition="boxes"))
+    with pytest.raises(ValueError, match="no learned condition"):
+        condition.valid(FIELD, jnp.zeros(4), dataclasses.replace(EnvConfig(), condition="learned"))
+    fitted = lf.save_params(
+        tmp_path / "fitted.npz", params, reachability=json.dumps(dataclasses.asdict(EnvConfig().reachability))
+    )
+    with pytest.raises(ValueError, match="fitted.npz.*another ReachabilityConfig"):
+        heightfield_from_terrain(
+            WALL, dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(fitted))
+        )

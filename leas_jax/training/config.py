@@ -96,6 +96,14 @@ class TrainConfig:
     hidden_sizes: tuple = (64, 64)  # paper §IV: 2 x 64 tanh
     seed: int = 0
     iterations_per_call: int = 4  # iterations fused into one compiled call (fewer host round trips)
+    # Planner mode with the learned condition (env.condition "learned"): every this many
+    # iterations, refit the condition on the generator's verdicts on the policy's guides so far
+    # (training/planner.py, `VerdictData`: DAgger); 0 never. An iteration of the planner
+    # presets validates 64 guides, which give ~100-250 labelled poses (a failure and up to four
+    # covered poses each); refitting every 4 iterations on at least 400 poses keeps each refit
+    # (200 Adam steps, a few seconds on 2 cores) small against the validation's minute.
+    condition_refresh_every: int = 0
+    condition_refresh_min_poses: int = 400
     checkpoint_every_s: float = 60.0  # wall-clock seconds between checkpoints
     keep_checkpoints: int = 3
     env: EnvConfig = field(
@@ -129,6 +137,10 @@ class TrainConfig:
             "iterations_per_call",
             "keep_checkpoints",
         ]
+        if self.condition_refresh_every < 0:
+            raise UsageError(
+                f"TrainConfig.condition_refresh_every must be >= 0, got {self.condition_refresh_every!r}"
+            )
         for name in positive:
             if not getattr(self, name) > 0:
                 raise UsageError(f"TrainConfig.{name} must be > 0, got {getattr(self, name)!r}")

@@ -258,9 +258,13 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
     resume from the saved PRNG key); only updated states are checkpointed.
     """
     from leas_jax.contacts.validation.pool import ValidationPool, available_cpus
-    from leas_jax.training.planner import guides_of, make_planner_fns
+    from leas_jax.env.learned_feasibility import load_params
+    from leas_jax.training.planner import VerdictData, guides_of, make_planner_fns
 
     rollout, update = make_planner_fns(config)
+    verdicts = VerdictData(config, seed=config.seed)
+    if verdicts.enabled and (log.run_dir / "condition.npz").is_file():  # a resumed run's refreshed condition
+        field = field.replace(condition=load_params(log.run_dir / "condition.npz")[0])
     timestep = config.env.timestep
     state = state.replace(env_state=None, episode_return=None, episode_length=None)
     start_iteration = int(state.iteration)
@@ -288,6 +292,16 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
             results = future.result()
             wait_s = time.perf_counter() - t_wait
             state, record = _apply_validated_batch(state, episodes, results, k_update, update)
+            if verdicts.enabled:
+                record["condition_poses_added"] = verdicts.add(
+                    guides_of(episodes), np.array([r.last_valid_index for r in results])
+                )
+                if verdicts.due():
+                    field, fit_info = verdicts.refresh(field)  # the next draws terminate on it
+                    verdicts.save(log.run_dir, field)
+                    record.update(
+                        condition_poses=fit_info["poses"], condition_threshold=fit_info["threshold"]
+                    )
             state = state.replace(key=next_state.key)
             episodes, future, k_update = next_episodes, next_future, next_k_update
             elapsed = time.perf_counter() - t0
@@ -303,6 +317,8 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
             log.maybe_checkpoint(state)
     finally:
         pool.close(cancel_pending=True)  # the batch in flight is not needed any more
+        if verdicts.enabled:
+            verdicts.save(log.run_dir, field)
     return state
 
 

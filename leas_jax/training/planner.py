@@ -269,3 +269,109 @@ def guides_of(episodes: EpisodeBatch) -> list[np.ndarray]:
     """Host: the guide path [L_n, 4] of each episode."""
     poses, lengths = jax.device_get((episodes.poses, episodes.guide_length))
     return [np.asarray(poses[n, : lengths[n]], np.float64) for n in range(len(lengths))]
+
+
+# The walking truth the learned condition is fitted on (benchmarks/reachability_calibration.py)
+# calls a pose feasible when the generator covers the 0.36 m guide from it: 20 steps at the
+# target speed and timestep. A covered guide pose is labelled feasible only when the guide
+# went on covered for that long after it (or was covered to its end).
+VERDICT_HORIZON = 20  # guide poses
+
+
+def verdict_samples(
+    guides: list[np.ndarray],
+    last_valid_index: np.ndarray,
+    rng: np.random.Generator,
+    covered_per_guide: int = 4,
+    horizon: int = VERDICT_HORIZON,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Host: the contact generator's verdicts on validated guides as labelled poses (DAgger data).
+
+    For each guide [L_n, 4] with last valid index l (-1: no first stance): when the guide is
+    not fully covered (l < L_n - 1), its first uncovered pose l + 1 is labelled infeasible
+    (the policy's own failure); up to `covered_per_guide` poses drawn among the covered ones
+    that the generator followed for `horizon` more poses (index <= l - horizon, every covered
+    pose of a fully covered guide) are labelled feasible.
+
+    Returns:
+        (poses [K, 4] (x, y, z, yaw), world; labels [K] bool).
+    """
+    poses, labels = [], []
+    for guide, lvi in zip(guides, np.asarray(last_valid_index), strict=True):
+        full = lvi >= len(guide) - 1
+        if not full:
+            poses.append(guide[lvi + 1][None])
+            labels.append(np.zeros(1, bool))
+        last_sure = len(guide) - 1 if full else lvi - horizon
+        if last_sure >= 0 and covered_per_guide > 0:
+            picks = rng.choice(last_sure + 1, size=min(covered_per_guide, last_sure + 1), replace=False)
+            poses.append(guide[np.sort(picks)])
+            labels.append(np.ones(len(picks), bool))
+    if not poses:
+        return np.zeros((0, 4)), np.zeros(0, bool)
+    return np.concatenate(poses).astype(np.float64), np.concatenate(labels)
+
+
+class VerdictData:
+    """Host: the DAgger loop of the learned condition during planner-in-the-loop training.
+
+    Every validated batch adds its verdicts (`verdict_samples`); every
+    `config.condition_refresh_every` iterations, once `config.condition_refresh_min_poses`
+    poses are in, the condition is refitted from its current weights on all of them
+    (`leas_jax.feasibility.fit` with `init`) and the field carries the new weights: the next
+    rollouts terminate where the refreshed condition says so, while the PPO update keeps the
+    generator's pruning. Only with `config.env.condition == "learned"` and a refresh period > 0.
+    """
+
+    def __init__(self, config: TrainConfig, seed: int = 0):
+        self.config = config
+        self.rng = np.random.default_rng(seed)
+        self.poses = np.zeros((0, 4))
+        self.labels = np.zeros(0, bool)
+        self.iterations = 0
+        self.refreshes = 0
+
+    @property
+    def enabled(self) -> bool:
+        return self.config.env.condition == "learned" and self.config.condition_refresh_every > 0
+
+    def add(self, guides: list[np.ndarray], last_valid_index: np.ndarray) -> int:
+        """Add one batch's verdicts; the number of poses added."""
+        poses, labels = verdict_samples(guides, last_valid_index, self.rng)
+        self.poses = np.concatenate([self.poses, poses])
+        self.labels = np.concatenate([self.labels, labels])
+        self.iterations += 1
+        return len(poses)
+
+    def due(self) -> bool:
+        """Whether this iteration refreshes the condition."""
+        return (
+            self.enabled
+            and self.iterations % self.config.condition_refresh_every == 0
+            and len(self.labels) >= self.config.condition_refresh_min_poses
+            and self.labels.any()
+            and not self.labels.all()
+        )
+
+    def refresh(self, field: Heightfield) -> tuple[Heightfield, dict]:
+        """The field with the condition refitted on every verdict so far, and the fit's info."""
+        from leas_jax.feasibility import FitConfig, features_of, fit
+
+        reach = self.config.env.reachability
+        x = features_of(field.condition, field, self.poses, reach)
+        params, info = fit(x, self.labels, FitConfig(seed=self.refreshes), init=field.condition, reach=reach)
+        self.refreshes += 1
+        return field.replace(condition=params), info
+
+    def save(self, run_dir, field: Heightfield) -> None:
+        """run_dir/condition.npz (the current weights) and condition_data.npz (the verdicts), atomically."""
+        import os
+        from pathlib import Path
+
+        from leas_jax.env.learned_feasibility import save_params
+
+        run_dir = Path(run_dir)
+        save_params(run_dir / "condition.npz", field.condition, refreshes=self.refreshes)
+        tmp = run_dir / f"condition_data.tmp{os.getpid()}.npz"
+        np.savez(tmp, poses=self.poses, labels=self.labels)
+        os.replace(tmp, run_dir / "condition_data.npz")

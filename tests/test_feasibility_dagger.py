@@ -1,0 +1,95 @@
+"""The DAgger loop of the learned condition: the generator's verdicts on the policy's guides
+become labelled poses, the policy's failed poses among them, and refresh the condition."""
+
+import dataclasses
+import os
+from types import SimpleNamespace
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from leas_jax.env import learned_feasibility as lf
+from leas_jax.training import preset, train
+from leas_jax.training.config import TRAINING_ENV
+from leas_jax.training.planner import VERDICT_HORIZON, verdict_samples
+
+FAIL_AT = 30  # the fake generator covers guide poses 0..FAIL_AT - 1
+
+
+def _guide(n, x0=0.0):
+    return np.column_stack([x0 + 0.01 * np.arange(n), np.zeros(n), np.ones(n), np.zeros(n)])
+
+
+def test_verdict_samples_by_hand():
+    # guide 0: 50 poses, covered to pose 29: pose 30 infeasible, covered picks among 0..9 (29 - 20)
+    # guide 1: 15 poses, fully covered: picks among all 15; guide 2: no first stance: pose 0 infeasible
+    # guide 3: covered to pose 5 of 40: pose 6 infeasible, no covered pose is sure (5 - 20 < 0)
+    guides = [_guide(50), _guide(15, 1.0), _guide(10, 2.0), _guide(40, 3.0)]
+    poses, labels = verdict_samples(guides, np.array([29, 14, -1, 5]), np.random.default_rng(0))
+    failed = poses[~labels]
+    np.testing.assert_allclose(failed, np.stack([guides[0][30], guides[2][0], guides[3][6]]))
+    covered = poses[labels]
+    assert len(covered) == 8  # four from guide 0, four from guide 1
+    x = covered[:, 0]
+    assert np.all((x[:4] >= 0.0) & (x[:4] <= 0.01 * (29 - VERDICT_HORIZON) + 1e-9))
+    assert np.all((x[4:] >= 1.0) & (x[4:] <= 1.14 + 1e-9))
+    empty_poses, empty_labels = verdict_samples([], np.zeros(0, int), np.random.default_rng(0))
+    assert empty_poses.shape == (0, 4) and empty_labels.shape == (0,)
+
+
+def _fail_at(terrain, guide, timestep, config=None):
+    """plan_fn: covers poses 0..FAIL_AT - 1 of each guide; records each first uncovered pose."""
+    last = min(FAIL_AT - 1, len(guide) - 1)
+    if last < len(guide) - 1:
+        with open(os.environ["LEAS_TEST_FAILED_POSES"], "a") as f:
+            f.write(" ".join(repr(float(v)) for v in guide[last + 1]) + "\n")
+    return SimpleNamespace(coverage=(last + 1) / len(guide), last_valid_index=last)
+
+
+@pytest.mark.slow  # ~90 s at load 12 on 2 cores: compiles the planner rollout, update and fit
+def test_the_loop_adds_the_policys_failed_poses_and_refreshes_the_condition(tmp_path, monkeypatch):
+    record_file = tmp_path / "failed.txt"
+    monkeypatch.setenv("LEAS_TEST_FAILED_POSES", str(record_file))
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=reach)
+    weights = lf.save_params(tmp_path / "start.npz", {**params, "threshold": jnp.asarray(-1e9)})
+    env = dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(weights))
+    config = preset(
+        "smoke",
+        mode="planner",
+        terrain="terrains/eval_ground.toml",
+        num_timesteps=200,
+        num_envs=8,
+        num_minibatches=2,
+        num_epochs=1,
+        checkpoint_every_s=0.0,
+        env=dataclasses.replace(env, episode_length=60),
+        condition_refresh_every=1,
+        condition_refresh_min_poses=10,
+    )
+    records = []
+    train(
+        config,
+        tmp_path / "run",
+        progress=False,
+        workers=0,
+        on_log=records.append,
+        pool_options=dict(plan_fn=_fail_at),
+    )
+    assert records and all(r["condition_poses_added"] > 0 for r in records)
+    assert "condition_threshold" in records[0]  # refreshed at the first iteration already
+    with np.load(tmp_path / "run" / "condition_data.npz") as data:
+        poses, labels = data["poses"], data["labels"]
+    recorded = np.loadtxt(record_file, ndmin=2)
+    failed = poses[~labels]
+    # every failed pose of the validated batches is in the data, labelled infeasible (the
+    # recorded file may also hold the batch in flight when the run stopped)
+    assert len(failed) > 0 and len(failed) <= len(recorded)
+    for pose in failed:
+        assert np.min(np.abs(recorded - pose).max(axis=1)) < 1e-5
+    assert labels.any()
+    refreshed, _ = lf.load_params(tmp_path / "run" / "condition.npz")
+    assert not np.array_equal(np.asarray(refreshed["w0"]), np.asarray(params["w0"]))
+    assert float(refreshed["threshold"]) > -1e9

@@ -230,6 +230,7 @@ def main(argv=None) -> None:
         train=f"{args.train_poses} fresh (seed {args.train_seed}) + {args.policy_train_poses} policy "
         f"(seed {args.policy_train_seed}) poses",
         fit=json.dumps(dataclasses.asdict(config)),
+        reachability=json.dumps(dataclasses.asdict(ReachabilityConfig())),  # whose margins it reads
     )
     print(f"wrote {weights} (fit {info['fit_seconds']} s, threshold {info['threshold']:.3f})")
 

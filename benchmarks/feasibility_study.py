@@ -1,0 +1,395 @@
+"""Ablation study of issue 19: does the learned condition, the planner in the loop, or both, make
+guides the contact generator can follow?
+
+Four methods, each trained from scratch with every seed of `--seeds` at equal env steps:
+
+* `cylinders`: geometric PPO with the paper's cylinders (the presets' TRAINING_REACHABILITY),
+  `--geometric-steps + --planner-steps` steps;
+* `cylinders+planner`: `--geometric-steps` geometric steps, then `--planner-steps` kept steps of
+  planner-in-the-loop PPO (the paper's pruning);
+* `learned`: geometric PPO terminating on the learned condition (`--weights`), all the steps;
+* `learned+planner`: as `cylinders+planner` with the learned condition, refreshed on the
+  generator's verdicts during the planner phase (DAgger, `--refresh-every`).
+
+Per policy (deterministic): on the training arena, from the env's own random resets
+(`--starts` per evaluation seed, `--eval-seeds`), the fraction of its guides the contact
+generator covers fully, their mean coverage and the mean progress along the target direction
+(400 steps, or `--episode-length`); the mean speed along the target on eval_ground; with
+`--scenarios`, LeaS success on those scenarios (`leas evaluate`). Each figure comes with a
+95 % interval across seeds and starts (a two-level bootstrap: seeds, then starts within each).
+
+    python benchmarks/feasibility_study.py --out DIR [--seeds 0,1,2] [--geometric-steps N]
+        [--planner-steps N] [--starts 256] [--eval-seeds 0,1] [--scenarios eval_stairs ...]
+
+Writes DIR/feasibility_study.json, feasibility_study.md and feasibility_study.png; training
+runs go to DIR/runs/<method>/seed<k> (a finished run is reused).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+METHODS = ("cylinders", "cylinders+planner", "learned", "learned+planner")
+METRICS = {  # name: (label, unit)
+    "full_coverage": ("guides fully covered", "%"),
+    "mean_coverage": ("mean coverage", "%"),
+    "progress_m": ("arena progress", "m"),
+    "ground_speed": ("eval_ground speed", "m/s"),
+}
+
+
+def bootstrap_interval(
+    groups: list[np.ndarray], resamples: int = 2000, seed: int = 0
+) -> tuple[float, float, float]:
+    """(mean, lo, hi): the mean of all values and its 95 % interval by a two-level bootstrap
+    (resample the groups, e.g. training seeds, then the values within each, e.g. starts).
+
+    Args:
+        groups: one 1-D array of values per group (non-empty).
+    """
+    groups = [np.asarray(g, float) for g in groups if len(g)]
+    if not groups:
+        return float("nan"), float("nan"), float("nan")
+    rng = np.random.default_rng(seed)
+    means = np.empty(resamples)
+    for r in range(resamples):
+        picked = rng.integers(0, len(groups), len(groups))
+        means[r] = np.mean(
+            np.concatenate([g[rng.integers(0, len(g), len(g))] for g in (groups[i] for i in picked)])
+        )
+    lo, hi = np.percentile(means, [2.5, 97.5])
+    return float(np.mean(np.concatenate(groups))), float(lo), float(hi)
+
+
+def method_configs(method: str, seed: int, args):
+    """(geometric TrainConfig, planner TrainConfig or None) of one method and seed."""
+    from leas_jax.training.config import PRESETS, TRAINING_ENV, preset
+
+    env = PRESETS[args.preset].get("env", TRAINING_ENV)  # the preset's env: `quick` adds the clearance term
+    if method.startswith("learned"):
+        # the learned condition reads the calibrated cylinders' margins: the field needs their rasters
+        env = dataclasses.replace(
+            env, condition="learned", learned_weights=args.weights, reachability=args.learned_reachability
+        )
+    env = dataclasses.replace(env, episode_length=args.episode_length)
+    planner = method.endswith("+planner")
+    geometric_steps = args.geometric_steps + (0 if planner else args.planner_steps)
+    geo = preset(
+        args.preset,
+        num_timesteps=geometric_steps,
+        seed=seed,
+        env=env,
+        **({"num_envs": args.num_envs, "num_minibatches": 4} if args.num_envs else {}),
+    )
+    if not planner:
+        return geo, None
+    plan = preset(
+        "smoke",
+        mode="planner",
+        num_timesteps=args.planner_steps,
+        num_envs=args.planner_envs,
+        num_minibatches=4 if args.planner_envs % 4 == 0 else 1,
+        num_epochs=4,
+        seed=seed,
+        env=env,
+        condition_refresh_every=args.refresh_every if method == "learned+planner" else 0,
+        condition_refresh_min_poses=args.refresh_min_poses,
+    )
+    return geo, plan
+
+
+def train_method(method: str, seed: int, args, out: Path) -> Path:
+    """Train one method and seed (a finished run is resumed to its end, i.e. reused); its run directory."""
+    from leas_jax.training import train
+
+    geo, plan = method_configs(method, seed, args)
+    run = out / "runs" / method.replace("+", "_") / f"seed{seed}"
+    train(geo, run / "geometric", progress=False)
+    if plan is None:
+        return run / "geometric"
+    plan = dataclasses.replace(plan, init_from=str(run / "geometric"))
+    train(plan, run / "planner", progress=False, workers=args.workers)
+    return run / "planner"
+
+
+def evaluate_policy(run_dir: Path, args) -> dict:
+    """Per-start arrays of one policy: full coverage and coverage of its arena guides, progress
+    (per evaluation seed, concatenated), speed on eval_ground."""
+    from leas_jax.contacts.validation.pool import validate_paths
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.eval.geometric import arena_episodes, ground_speed
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.config import resolve_data_path
+    from leas_jax.training.policy import load_policy
+
+    policy = load_policy(run_dir)
+    env = policy.config.env
+    refreshed = run_dir / "condition.npz"
+    if env.condition == "learned" and refreshed.is_file():  # the DAgger run's own condition
+        env = dataclasses.replace(env, learned_weights=str(refreshed))
+    policy = dataclasses.replace(policy, config=dataclasses.replace(policy.config, env=env))
+    arena = load_terrain(policy.config.terrain_path())
+    field = heightfield_from_terrain(arena, env)
+    full, coverage, progress = [], [], []
+    for eval_seed in args.eval_seeds:
+        episodes = arena_episodes(policy, field, n=args.starts, seed=eval_seed, steps=args.episode_length)
+        guides = [episodes.poses[k, : episodes.lengths[k]].astype(np.float64) for k in range(args.starts)]
+        results = validate_paths(arena, guides, env.timestep, workers=args.workers, return_plans=False)
+        cov = np.array([r.coverage for r in results])
+        full.append(cov >= 1.0)
+        coverage.append(cov)
+        start = episodes.poses[:, 0, :2]
+        final = episodes.poses[np.arange(args.starts), episodes.lengths - 1, :2]
+        progress.append(_progress(policy, field, eval_seed, args.starts, start, final))
+    ground = load_terrain(resolve_data_path("terrains/eval_ground.toml"))
+    speed = ground_speed(
+        policy,
+        ground,
+        heightfield_from_terrain(ground, env),
+        n=args.ground_starts,
+        seed=2,
+        steps=args.episode_length,
+    )
+    out = {
+        "full_coverage": np.concatenate(full).astype(float),
+        "mean_coverage": np.concatenate(coverage),
+        "progress_m": np.concatenate(progress),
+        "ground_speed": np.asarray(speed.per_episode),
+    }
+    if args.scenarios:
+        out["scenarios"] = _scenario_success(run_dir, args)
+    return out
+
+
+def _progress(policy, field, seed, n, start, final) -> np.ndarray:
+    """[n] displacement along each episode's target direction (m): the env's resets of `arena_episodes`."""
+    import jax
+
+    from leas_jax.env import LeasEnv
+
+    env = LeasEnv(field, policy.config.env)
+    dirs = jax.vmap(lambda k: env.reset(k).pipeline_state.target_dir)(
+        jax.random.split(jax.random.PRNGKey(seed), n)
+    )
+    return np.sum((final - start) * np.asarray(dirs), axis=1)
+
+
+def _scenario_success(run_dir: Path, args) -> dict:
+    """{scenario: [starts] 1.0 where LeaS succeeded} (`leas evaluate`'s seeded starts)."""
+    from leas_jax.eval.evaluate import evaluate
+
+    report = evaluate(
+        list(args.scenarios),
+        methods=["leas"],
+        checkpoint=run_dir,
+        out=None,
+        n_starts=args.scenario_starts,
+        workers=args.workers,
+        progress=False,
+        figures=False,
+    )
+    return {
+        name: np.array([float(t["success"]) for t in scenario["trajectories"] if t["method"] == "leas"])
+        for name, scenario in report["scenarios"].items()
+    }
+
+
+def summarise(per_seed: dict) -> dict:
+    """{method: {metric: {mean, lo, hi, seeds}}} from {method: [per-seed dict of arrays]}."""
+    table = {}
+    for method, runs in per_seed.items():
+        row = {}
+        for metric in METRICS:
+            mean, lo, hi = bootstrap_interval([r[metric] for r in runs])
+            row[metric] = {
+                "mean": mean,
+                "lo": lo,
+                "hi": hi,
+                "per_seed": [float(np.mean(r[metric])) for r in runs],
+            }
+        scenarios = {}
+        for run in runs:
+            for name, values in run.get("scenarios", {}).items():
+                scenarios.setdefault(name, []).append(values)
+        for name, groups in scenarios.items():
+            mean, lo, hi = bootstrap_interval(groups)
+            row[f"scenario/{name}"] = {
+                "mean": mean,
+                "lo": lo,
+                "hi": hi,
+                "per_seed": [float(np.mean(g)) for g in groups],
+            }
+        table[method] = row
+    return table
+
+
+def _cell(entry: dict, unit: str) -> str:
+    scale = 100.0 if unit == "%" else 1.0
+    digits = 1 if unit == "%" else 3
+    return f"{scale * entry['mean']:.{digits}f} [{scale * entry['lo']:.{digits}f}, {scale * entry['hi']:.{digits}f}]"
+
+
+def markdown(report: dict) -> str:
+    """The study's table: every metric of every method with its 95 % interval."""
+    table = report["summary"]
+    metrics = list(METRICS) + sorted({k for row in table.values() for k in row if k.startswith("scenario/")})
+
+    def label(m: str) -> str:
+        return f"{METRICS[m][0]} ({METRICS[m][1]})" if m in METRICS else m.split("/", 1)[1] + " success (%)"
+
+    def unit(m: str) -> str:
+        return METRICS[m][1] if m in METRICS else "%"
+
+    s = report["settings"]
+    lines = [
+        "# Feasibility ablation",
+        "",
+        f"{len(s['seeds'])} training seeds, {s['geometric_steps']} geometric + {s['planner_steps']} planner env steps "
+        f"(the geometric-only methods train all of them geometrically); {s['starts']} arena starts x "
+        f"{len(s['eval_seeds'])} evaluation seeds, {s['episode_length']}-step episodes. Mean [95 % interval "
+        "across seeds and starts].",
+        "",
+        "| method | " + " | ".join(label(m) for m in metrics) + " |",
+        "|---|" + "---|" * len(metrics),
+    ]
+    for method, row in table.items():
+        lines.append(
+            f"| {method} | " + " | ".join(_cell(row[m], unit(m)) if m in row else "-" for m in metrics) + " |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def figure(report: dict, path: Path) -> None:
+    """One panel per metric: each method's mean and 95 % interval."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    table = report["summary"]
+    fig, axes = plt.subplots(1, len(METRICS), figsize=(4 * len(METRICS), 3.5))
+    methods = list(table)
+    for ax, (metric, (name, unit)) in zip(axes, METRICS.items(), strict=True):
+        scale = 100.0 if unit == "%" else 1.0
+        means = np.array([table[m][metric]["mean"] for m in methods]) * scale
+        lo = np.array([table[m][metric]["lo"] for m in methods]) * scale
+        hi = np.array([table[m][metric]["hi"] for m in methods]) * scale
+        ax.bar(
+            range(len(methods)), means, yerr=[means - lo, hi - means], capsize=4, color="tab:blue", alpha=0.7
+        )
+        ax.set_xticks(range(len(methods)), methods, rotation=30, ha="right", fontsize=8)
+        ax.set_title(f"{name} ({unit})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _parse_ints(name: str, text: str) -> tuple[int, ...]:
+    from leas_jax.errors import UsageError
+
+    try:
+        values = tuple(int(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise UsageError(f"--{name}: expected comma-separated integers, got {text!r}") from None
+    if not values:
+        raise UsageError(f"--{name}: expected at least one integer")
+    return values
+
+
+def main(argv=None) -> dict:
+    from common import machine
+
+    from leas_jax.env import ReachabilityConfig
+    from leas_jax.errors import UsageError
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--methods", default=",".join(METHODS))
+    parser.add_argument("--seeds", default="0,1,2")
+    parser.add_argument(
+        "--preset", default="quick", help="geometric preset (its PPO settings; steps and env are set here)"
+    )
+    parser.add_argument("--num-envs", type=int, default=0, help="geometric envs (0: the preset's)")
+    parser.add_argument("--geometric-steps", type=int, default=20_000_000)
+    parser.add_argument("--planner-steps", type=int, default=50_000, help="kept planner-in-the-loop steps")
+    parser.add_argument("--planner-envs", type=int, default=64, help="guides validated per planner iteration")
+    parser.add_argument(
+        "--refresh-every", type=int, default=4, help="learned+planner: DAgger refresh period (iterations)"
+    )
+    parser.add_argument("--refresh-min-poses", type=int, default=400)
+    parser.add_argument("--weights", default="checkpoints/feasibility/walking.npz")
+    parser.add_argument("--starts", type=int, default=256, help="arena starts per evaluation seed")
+    parser.add_argument("--eval-seeds", default="0,1")
+    parser.add_argument("--ground-starts", type=int, default=256)
+    parser.add_argument("--episode-length", type=int, default=400)
+    parser.add_argument("--scenarios", nargs="*", default=[])
+    parser.add_argument("--scenario-starts", type=int, default=30)
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args(argv)
+    methods = tuple(m for m in args.methods.split(",") if m)
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        raise UsageError(f"--methods: unknown {', '.join(unknown)}; choose among {', '.join(METHODS)}")
+    args.seeds = _parse_ints("seeds", args.seeds)
+    args.eval_seeds = _parse_ints("eval-seeds", args.eval_seeds)
+    for name in (
+        "geometric_steps",
+        "planner_steps",
+        "planner_envs",
+        "starts",
+        "ground_starts",
+        "episode_length",
+    ):
+        if getattr(args, name) < 1:
+            raise UsageError(f"--{name.replace('_', '-')} must be >= 1")
+    args.learned_reachability = ReachabilityConfig()  # the margins the shipped weights were fitted on
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    began = time.perf_counter()
+    per_seed, timings = {}, {}
+    for method in methods:
+        per_seed[method] = []
+        for seed in args.seeds:
+            t0 = time.perf_counter()
+            run = train_method(method, seed, args, out)
+            t1 = time.perf_counter()
+            per_seed[method].append(evaluate_policy(run, args))
+            timings[f"{method}/seed{seed}"] = {
+                "train_s": round(t1 - t0, 1),
+                "eval_s": round(time.perf_counter() - t1, 1),
+            }
+            print(
+                f"{method} seed {seed}: trained {t1 - t0:.0f} s, evaluated {time.perf_counter() - t1:.0f} s",
+                flush=True,
+            )
+    settings = {
+        k: (list(v) if isinstance(v, tuple) else v)
+        for k, v in vars(args).items()
+        if k not in ("out", "learned_reachability")
+    }
+    report = {
+        "format": "leas-feasibility-study-v1",
+        "settings": settings,
+        "summary": summarise(per_seed),
+        "timings": timings,
+        "seconds": round(time.perf_counter() - began, 1),
+        "machine": machine(),
+    }
+    (out / "feasibility_study.json").write_text(json.dumps(report, indent=2))
+    (out / "feasibility_study.md").write_text(markdown(report))
+    figure(report, out / "feasibility_study.png")
+    print(markdown(report))
+    return report
+
+
+if __name__ == "__main__":
+    main()

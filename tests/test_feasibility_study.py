@@ -1,0 +1,105 @@
+"""benchmarks/feasibility_study.py: the two-level bootstrap, the table and plot, and the whole
+study end to end on tiny settings (four methods, tiny training and evaluation)."""
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+import feasibility_study as fs  # noqa: E402
+
+from leas_jax.errors import UsageError  # noqa: E402
+
+
+def test_bootstrap_interval_brackets_the_mean_and_widens_with_seed_spread():
+    rng = np.random.default_rng(0)
+    tight = [rng.normal(0.5, 0.1, 200) for _ in range(3)]
+    spread = [rng.normal(m, 0.1, 200) for m in (0.2, 0.5, 0.8)]
+    mean, lo, hi = fs.bootstrap_interval(tight)
+    assert lo < mean < hi and hi - lo < 0.05
+    mean2, lo2, hi2 = fs.bootstrap_interval(spread)
+    assert lo2 < mean2 < hi2 and hi2 - lo2 > 4 * (hi - lo)  # the seeds' spread counts
+    assert all(np.isnan(v) for v in fs.bootstrap_interval([]))
+
+
+def test_summary_table_and_figure(tmp_path):
+    runs = [
+        {
+            "full_coverage": np.array([1.0, 0.0, 1.0]),
+            "mean_coverage": np.array([1.0, 0.5, 1.0]),
+            "progress_m": np.array([3.0, 2.0, 4.0]),
+            "ground_speed": np.array([0.15, 0.16]),
+            "scenarios": {"eval_stairs": np.array([1.0, 1.0])},
+        }
+    ] * 2
+    summary = fs.summarise({"cylinders": runs, "learned": runs})
+    assert summary["cylinders"]["full_coverage"]["mean"] == pytest.approx(2 / 3)
+    assert summary["learned"]["scenario/eval_stairs"]["mean"] == 1.0
+    report = {
+        "summary": summary,
+        "settings": {
+            "seeds": [0, 1],
+            "geometric_steps": 10,
+            "planner_steps": 5,
+            "starts": 3,
+            "eval_seeds": [0],
+            "episode_length": 400,
+        },
+    }
+    text = fs.markdown(report)
+    assert "| cylinders | 66.7 [" in text and "eval_stairs success (%)" in text
+    fs.figure(report, tmp_path / "f.png")
+    assert (tmp_path / "f.png").stat().st_size > 1000
+
+
+def test_bad_arguments_name_the_option(tmp_path):
+    with pytest.raises(UsageError, match="--methods"):
+        fs.main(["--out", str(tmp_path), "--methods", "cylinders,boxes"])
+    with pytest.raises(UsageError, match="--seeds"):
+        fs.main(["--out", str(tmp_path), "--seeds", "a"])
+
+
+TINY = [
+    "--seeds",
+    "0",
+    "--preset",
+    "smoke",
+    "--num-envs",
+    "32",
+    "--geometric-steps",
+    "2048",
+    "--planner-steps",
+    "40",
+    "--planner-envs",
+    "4",
+    "--refresh-every",
+    "1",
+    "--refresh-min-poses",
+    "2",
+    "--starts",
+    "3",
+    "--eval-seeds",
+    "0",
+    "--ground-starts",
+    "3",
+    "--episode-length",
+    "25",
+    "--workers",
+    "0",
+]
+
+
+@pytest.mark.slow  # the four methods' training and evaluation compile ~10 jitted programs
+def test_study_runs_end_to_end_on_tiny_settings(tmp_path):
+    report = fs.main(["--out", str(tmp_path)] + TINY)
+    assert set(report["summary"]) == set(fs.METHODS)
+    saved = json.loads((tmp_path / "feasibility_study.json").read_text())
+    for method in fs.METHODS:
+        for metric in fs.METRICS:
+            entry = saved["summary"][method][metric]
+            assert entry["lo"] <= entry["mean"] <= entry["hi"], (method, metric)
+    assert (tmp_path / "feasibility_study.png").is_file() and (tmp_path / "feasibility_study.md").is_file()
+    assert (tmp_path / "runs" / "learned_planner" / "seed0" / "planner" / "condition_data.npz").is_file()

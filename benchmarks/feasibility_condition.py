@@ -70,12 +70,15 @@ def env_step_cost(terrain, envs: int, steps: int, repeats: int, weights: str) ->
     """
     import jax
 
-    from leas_jax.env import FreshResetVmap, LeasEnv, heightfield_from_terrain
+    from leas_jax.env import FreshResetVmap, LeasEnv, ReachabilityConfig, heightfield_from_terrain
     from leas_jax.training.config import TRAINING_ENV
 
     configs = {
         "cylinders": TRAINING_ENV,
-        "learned": dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=weights),
+        # the learned condition reads the calibrated cylinders' margins: its field has their rasters
+        "learned": dataclasses.replace(
+            TRAINING_ENV, condition="learned", learned_weights=weights, reachability=ReachabilityConfig()
+        ),
     }
 
     def compiled(config):

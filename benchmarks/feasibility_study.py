@@ -355,10 +355,17 @@ def main(argv=None) -> dict:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     began = time.perf_counter()
-    per_seed, timings = {}, {}
-    for method in methods:
-        per_seed[method] = []
-        for seed in args.seeds:
+    per_seed, timings = {m: [] for m in methods}, {}
+    settings = {
+        k: (list(v) if isinstance(v, tuple) else v)
+        for k, v in vars(args).items()
+        if k not in ("out", "learned_reachability")
+    }
+    report = {}
+    # seeds outer, methods inner: the report is rewritten after every run, so a study stopped
+    # early holds every method for the seeds it finished
+    for seed in args.seeds:
+        for method in methods:
             t0 = time.perf_counter()
             run = train_method(method, seed, args, out)
             t1 = time.perf_counter()
@@ -371,21 +378,16 @@ def main(argv=None) -> dict:
                 f"{method} seed {seed}: trained {t1 - t0:.0f} s, evaluated {time.perf_counter() - t1:.0f} s",
                 flush=True,
             )
-    settings = {
-        k: (list(v) if isinstance(v, tuple) else v)
-        for k, v in vars(args).items()
-        if k not in ("out", "learned_reachability")
-    }
-    report = {
-        "format": "leas-feasibility-study-v1",
-        "settings": settings,
-        "summary": summarise(per_seed),
-        "timings": timings,
-        "seconds": round(time.perf_counter() - began, 1),
-        "machine": machine(),
-    }
-    (out / "feasibility_study.json").write_text(json.dumps(report, indent=2))
-    (out / "feasibility_study.md").write_text(markdown(report))
+            report = {
+                "format": "leas-feasibility-study-v1",
+                "settings": {**settings, "seeds_done": sorted({int(k.split("seed")[-1]) for k in timings})},
+                "summary": summarise({m: runs for m, runs in per_seed.items() if runs}),
+                "timings": timings,
+                "seconds": round(time.perf_counter() - began, 1),
+                "machine": machine(),
+            }
+            (out / "feasibility_study.json").write_text(json.dumps(report, indent=2))
+            (out / "feasibility_study.md").write_text(markdown(report))
     figure(report, out / "feasibility_study.png")
     print(markdown(report))
     return report

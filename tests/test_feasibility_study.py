@@ -86,7 +86,7 @@ TINY = [
     "--ground-starts",
     "3",
     "--episode-length",
-    "25",
+    "60",
     "--workers",
     "0",
 ]

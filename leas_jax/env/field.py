@@ -309,10 +309,17 @@ def _condition_params(config: EnvConfig) -> dict:
         raise ValueError(f"EnvConfig.condition must be 'cylinders' or 'learned', got {config.condition!r}")
     import json
 
-    from leas_jax.env.learned_feasibility import load_params, resolve_weights
+    from leas_jax.env.learned_feasibility import load_params, margin_count, resolve_weights
 
     path = resolve_weights(config.learned_weights)
     params, metadata = load_params(path)
+    features = len(params["grid"]) + 1 + margin_count(config.reachability)
+    if params["mean"].shape != (features,):
+        raise ValueError(
+            f"{path}: the learned condition reads {params['mean'].shape[0]} features, but its patch and "
+            f"the margins of EnvConfig.reachability give {features}: build the env with the "
+            "ReachabilityConfig it was fitted with"
+        )
     fitted = metadata.get("reachability")
     if fitted is not None and json.loads(fitted) != dataclasses.asdict(config.reachability):
         raise ValueError(

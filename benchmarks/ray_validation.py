@@ -5,7 +5,7 @@ paths) with `ValidationPool.map`, for 1 and 2 local worker processes and 1 and 2
 Ray actors on a local Ray instance (`address="local"`). Each pool is opened and
 warmed with one full batch (workers load the Talos model and the sample
 database), then timed over `--runs` batches. The results must be identical
-across backends. Writes results/ray_validation.json.
+across backends. Writes <out>/ray_validation.json.
 
     python benchmarks/ray_validation.py [--runs 3]
 """
@@ -21,7 +21,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
 
 SETTINGS = (
     ("local processes", dict(workers=1)),
@@ -50,7 +50,9 @@ def measure(terrain, guides, timestep: float, runs: int, options: dict) -> tuple
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
+    add_out_argument(parser)
     args = parser.parse_args()
+    load_before = load_average()
     from test_contacts_pool_generator import DT, GUIDES, TERRAIN
 
     guides = GUIDES * 8
@@ -67,7 +69,7 @@ def main() -> None:
             f"{len(guides)} paths in {', '.join(f'{s:.2f}' for s in figures['batch_s'])} s",
             flush=True,
         )
-    save("ray_validation", {"runs": args.runs, "rows": rows})
+    save("ray_validation", {"runs": args.runs, "rows": rows}, load_before, args.out)
 
 
 if __name__ == "__main__":

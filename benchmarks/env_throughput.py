@@ -16,8 +16,8 @@ envs stepped one by one.
 Compile time (lower + compile) is apart from run time; every timing ends with
 `block_until_ready`. The repeats alternate between the programs, and the env's
 throughput is also given as a ratio to the reference's in the same repeat (the
-median over repeats), which the machine's load moves much less than steps/s, and
-per CPU-second of the process (all its threads).
+median over repeats), which the machine's load moves much less than steps/s; and
+per CPU-second of the process (all its threads), with its ratio to the reference's.
 Writes <out>/env_throughput.json.
 
     python benchmarks/env_throughput.py [--envs 256,1024,8192] [--steps 200] [--repeats 3] [--preset quick]
@@ -150,6 +150,8 @@ def measure(field, config, num_envs: int, steps: int, repeats: int) -> dict:
         # the reference's time over the env's in the same repeat: the env's throughput as a fraction of it
         ratios = [ref / env for ref, env in zip(times["reference"], times[kind])]
         row["programs"][kind]["ratio_to_reference"] = round(statistics.median(ratios), 4)
+        cpu_ratios = [ref / env for ref, env in zip(cpu["reference"], cpu[kind])]
+        row["programs"][kind]["ratio_to_reference_cpu"] = round(statistics.median(cpu_ratios), 4)
     return row
 
 
@@ -174,17 +176,19 @@ def main(argv=None) -> None:
     rows = []
     print(
         f"{'envs':>6s} {'program':10s} {'steps/s best':>13s} {'median':>11s} {'/ reference':>11s} "
-        f"{'per CPU-s':>11s} {'compile s':>9s}  checksum (obs, reward, done)"
+        f"{'per CPU-s':>11s} {'/ ref CPU':>9s} {'compile s':>9s}  checksum (obs, reward, done)"
     )
     for n in [int(v) for v in args.envs.split(",")]:
         row = measure(field, config, n, args.steps, args.repeats)
         rows.append(row)
         for kind, p in row["programs"].items():
-            ratio = f"{p['ratio_to_reference']:11.3f}" if "ratio_to_reference" in p else f"{'1':>11s}"
+            ratio = f"{p.get('ratio_to_reference', 1.0):11.3f}"
+            cpu_ratio = f"{p.get('ratio_to_reference_cpu', 1.0):9.3f}"
             c = p["checksum"]
             print(
                 f"{n:6d} {kind:10s} {p['steps_per_s_best']:13,} {p['steps_per_s_median']:11,} {ratio} "
-                f"{p['steps_per_cpu_s_median']:11,} {p['compile_s']:9.1f}  ({c['obs']:.6g}, {c['reward']:.6g}, {c['done']:.6g})"
+                f"{p['steps_per_cpu_s_median']:11,} {cpu_ratio} {p['compile_s']:9.1f}  "
+                f"({c['obs']:.6g}, {c['reward']:.6g}, {c['done']:.6g})"
                 + ("" if p["checksum_repeatable"] else "  NOT REPEATABLE"),
                 flush=True,
             )
@@ -200,6 +204,7 @@ def main(argv=None) -> None:
             },
             "checksum": "per program, the sums over all steps and envs of the observation, reward and done flag",
             "ratio_to_reference": "median over repeats of reference time / env time in the same repeat",
+            "ratio_to_reference_cpu": "the same with the process's CPU times",
             "rows": rows,
         },
         load_before,

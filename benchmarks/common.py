@@ -48,6 +48,10 @@ def git_state(repo: Path = REPO) -> dict:
     return {"commit": commit, "dirty": bool(status.strip())}
 
 
+# read when a benchmark starts (imports this module), so that the record names the code that ran
+GIT_AT_START = git_state()
+
+
 def machine() -> dict:
     """What the figures were measured on: CPU model, cores, memory, JAX backend and versions."""
     import jax
@@ -95,13 +99,13 @@ def save(name: str, payload: dict, load_before: dict, out: Path = RESULTS) -> Pa
         out: folder (created if missing).
 
     The file holds the payload with the benchmark's name, the time, the machine, the
-    git state, and the load average before and after (now).
+    git state when the benchmark started, and the load average before and after (now).
     """
     record = {
         "benchmark": name,
         "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         "machine": machine(),
-        "git": git_state(),
+        "git": GIT_AT_START,
         "load_average_before": load_before,
         "load_average_after": load_average(),
         **payload,

@@ -36,8 +36,8 @@ REPO_ROOT = Path(__file__).resolve().parents[2]
 # r 0.05 m reaching 0.55-1.175 m below the root; no lookahead, foothold or hands term.
 # It is looser than ReachabilityConfig's calibrated default (sensitivity / specificity
 # 78.6 / 89.7 % against the walking generator on 48 000 arena poses, where the default
-# gives 95.7 / 90.0 %). Geometric policies trained with the ninth session's calibrated
-# default (trunk bottom -0.70 m, no foothold term) climb eval_stairs and follow
+# gives 95.7 / 90.0 %). Geometric policies trained with the calibrated
+# default of commit 04b7a87 (trunk bottom -0.70 m, no foothold term) climb eval_stairs and follow
 # eval_circuit more reliably, but barely step onto eval_bridge's beam (0-11.7 % over four
 # `quick` seeds against 0-43.3 %: its lookahead legs must be on the 0.30 m beam 0.30 m before
 # the root is), a `paper` run with it fell behind the shipped pretrain everywhere but the

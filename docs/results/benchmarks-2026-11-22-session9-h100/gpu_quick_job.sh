@@ -1,5 +1,5 @@
 #!/bin/bash
-# GPU quick-train + arena-check (session 9). Run from the repo root on the device.
+# GPU quick-train + arena-check (2026-11-22). Run from the repo root on the device.
 set -o pipefail
 ROOT=$PWD
 LOG=$OUT/gpu_quick_device.log

@@ -12,9 +12,11 @@ from __future__ import annotations
 import collections
 import dataclasses
 import itertools
+import logging
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 import traceback as traceback_module
@@ -39,6 +41,38 @@ from leas_jax.contacts.validation.runner import (
 
 # How long close() waits for a worker to exit after asking it to, before SIGKILL.
 _STOP_GRACE = 5.0  # s
+# Exit status of a worker that found itself re-running the caller's script (see
+# `refuse_bootstrap_start`): EX_CONFIG of sysexits.h, a usage mistake, not a crash.
+SPAWN_GUARD_EXIT = 78
+
+logger = logging.getLogger(__name__)
+
+SPAWN_GUARD_MESSAGE = (
+    "contact workers could not start: the script that started the validation pool runs it at "
+    "import time. Workers are started with 'spawn' (JAX threads do not survive 'fork'), and a "
+    "spawned worker imports the main script again, so each worker tried to start a pool of its own. "
+    "Put the code that calls validate_paths / ValidationPool under\n"
+    '    if __name__ == "__main__":\n'
+    "in the script {script}, or pass workers=0 to plan in this process."
+)
+
+
+def refuse_bootstrap_start() -> None:
+    """Stop a spawned worker that is re-running its parent's main script and reached a pool.
+
+    A spawned child re-imports the parent's `__main__` (as `__mp_main__`) before it
+    unpickles its target; a script that makes a pool at top level then makes one in
+    every child, which multiprocessing refuses with a traceback the parent never sees.
+    Called where a pool would start processes: in such a child (multiprocessing marks its
+    bootstrapping phase with `current_process()._inheriting`, the flag its own check
+    reads), print why to stderr and exit with `SPAWN_GUARD_EXIT`, which the parent
+    turns into a `ValidationPoolError` that says how to fix the script.
+    """
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        main = sys.modules.get("__main__")
+        script = getattr(main, "__file__", None) or "<main script>"
+        print(SPAWN_GUARD_MESSAGE.format(script=script), file=sys.stderr, flush=True)
+        raise SystemExit(SPAWN_GUARD_EXIT)
 
 
 def _worker_main(conn, spec: WorkerSpec) -> None:
@@ -153,6 +187,7 @@ class _ProcessBackend(_QueuedBackend):
         self._startup_deaths = 0
         # Self-pipe: submit/close wake the dispatcher out of its wait().
         self._wake_reader, self._wake_writer = multiprocessing.Pipe(duplex=False)
+        refuse_bootstrap_start()
         with self._lock:
             self._spawn_missing()
         self._thread = threading.Thread(target=self._run, name="leas-validation-pool", daemon=True)
@@ -226,7 +261,11 @@ class _ProcessBackend(_QueuedBackend):
         task = worker.task
         if not worker.ready and not worker.retiring:
             self._startup_deaths += 1
-            if self._startup_deaths >= _MAX_STARTUP_DEATHS:
+            if worker.process.exitcode == SPAWN_GUARD_EXIT:
+                main = sys.modules.get("__main__")
+                script = getattr(main, "__file__", None) or "<main script>"
+                self._break(ValidationPoolError(SPAWN_GUARD_MESSAGE.format(script=script)))
+            elif self._startup_deaths >= _MAX_STARTUP_DEATHS:
                 self._break(
                     ValidationPoolError(
                         f"{self._startup_deaths} contact workers died during start-up "
@@ -237,6 +276,12 @@ class _ProcessBackend(_QueuedBackend):
             return
         pid = worker.pid if worker.pid is not None else worker.process.pid
         if worker.timed_out:
+            logger.warning(
+                "contact worker pid %s killed: path %d ran past the task timeout of %g s",
+                pid,
+                task.index,
+                self._task_timeout,
+            )
             self._complete(
                 task,
                 PathResult(
@@ -253,9 +298,26 @@ class _ProcessBackend(_QueuedBackend):
             return
         how = _describe_exit(worker.process.exitcode)
         if task.attempts < self._max_attempts:
+            logger.warning(
+                "contact worker pid %s %s while planning path %d (attempt %d of %d); "
+                "retrying the path on a fresh worker",
+                pid,
+                how,
+                task.index,
+                task.attempts,
+                self._max_attempts,
+            )
             # Front of the queue: the retry should not wait behind later batches.
             self._queue.appendleft(task)
         else:
+            logger.warning(
+                "contact worker pid %s %s while planning path %d, on each of %d attempts; "
+                "the path is reported as an error",
+                pid,
+                how,
+                task.index,
+                task.attempts,
+            )
             self._complete(
                 task,
                 PathResult(

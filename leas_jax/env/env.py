@@ -113,15 +113,7 @@ class LeasEnv(Env):
         )
 
     def _zero_metrics(self) -> dict:
-        names = (
-            "direction",
-            "orientation",
-            "effort_orientation",
-            "effort_acceleration",
-            "alive",
-            "clearance",
-        )
-        metrics = {f"reward/{n}": jnp.zeros(()) for n in names}
+        metrics = {f"reward/{n}": v for n, v in reward.zeros().items()}
         metrics.update(invalid=jnp.zeros(()), reached=jnp.zeros(()))
         return metrics
 
@@ -221,13 +213,8 @@ class LeasEnv(Env):
         steps = root.steps + 1
         root = root.replace(pos=pos, vel=vel, yaw=yaw, target_dir=target_dir, steps=steps)
 
-        terms = reward.terms(vel, yaw, action, target_dir, cfg)
+        terms = reward.terms(self.field, root.pose, vel, action, target_dir, cfg)
         ok = reachability.valid(self.field, root.pose, cfg.reachability)
-        terms["clearance"] = (
-            -reachability.clearance_shortfall(self.field, root.pose, cfg.clearance_margin, cfg.reachability)
-            if cfg.rewards.clearance != 0.0
-            else jnp.zeros(())
-        )
         reached = root.follow_point & (
             jnp.linalg.norm(root.target_point - pos[:2]) < cfg.target_reached_distance
         )

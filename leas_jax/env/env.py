@@ -22,7 +22,8 @@ with contextlib.redirect_stdout(io.StringIO()):
 
 from leas_jax.env import heightmap, kinematics, reachability, reward
 from leas_jax.env.config import EnvConfig
-from leas_jax.env.field import Heightfield, sample_bilinear
+from leas_jax.env.field import Heightfield, heightfield_from_terrain, sample_bilinear
+from leas_jax.terrain.model import Terrain
 
 
 @struct.dataclass
@@ -74,7 +75,23 @@ class LeasEnv(Env):
     within `target_reached_distance` of the target point.
     """
 
-    def __init__(self, field: Heightfield, config: EnvConfig = EnvConfig()):
+    def __init__(self, field: Heightfield | Terrain, config: EnvConfig = EnvConfig()):
+        """Args:
+        field: the terrain's `Heightfield` (`heightfield_from_terrain`), or a loaded
+            `Terrain` (`load_terrain(path)`), whose heightfield is then built here (host-side,
+            once; build it yourself to share it between envs or configs).
+        config: the MDP's parameters.
+
+        Raises:
+            TypeError: `field` is neither.
+        """
+        if isinstance(field, Terrain):
+            field = heightfield_from_terrain(field, config)
+        elif not isinstance(field, Heightfield):
+            raise TypeError(
+                f"LeasEnv(field): expected a Heightfield or a Terrain, got {type(field).__name__}; "
+                "pass load_terrain(path) or heightfield_from_terrain(terrain, config)"
+            )
         self.field = field
         self.config = config
 

@@ -15,7 +15,10 @@ hpp-centroidal-dynamics), so the paths are spread over worker processes:
 Design points (why):
 
 * Processes are started with `spawn` (default) or `forkserver`, never `fork`:
-  the parent usually holds JAX/XLA threads, which do not survive a fork.
+  the parent usually holds JAX/XLA threads, which do not survive a fork. A spawned
+  worker imports the caller's main script again, so a script must start its pool
+  under `if __name__ == "__main__":`; one that does not gets a `ValidationPoolError`
+  saying so (`process.refuse_bootstrap_start`), not a bare start-up failure.
 * Each worker loads the terrain (sent once, as its TOML text) and builds the
   planner (Talos model, sample database) once, in its start-up phase, then
   plans any number of paths. A long-lived `ValidationPool` keeps its workers
@@ -25,7 +28,9 @@ Design points (why):
   derived from the path's index only (`path_seed`). Nothing random is shared.
 * A worker that dies while planning a path (segfault, `os._exit`, SIGKILL by the
   OOM killer) is detected through its process sentinel; the path is retried
-  once on a fresh worker, then reported as an error `PathResult` for that path.
+  once on a fresh worker, then reported as an error `PathResult` for that path;
+  each death is logged (a warning on the `leas_jax.contacts.validation.process`
+  logger naming the worker's pid and the path).
   A path that runs longer than `task_timeout` gets its worker killed and is
   reported as an error (not retried: planning is deterministic, a rerun would
   time out again). Paths are never silently dropped and the caller never

@@ -140,7 +140,7 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
 
 
 def register(subparsers) -> None:
-    from leas_jax.cli import add_ray_address_argument
+    from leas_jax.arguments import add_ray_address_argument
 
     parser = subparsers.add_parser(
         "evaluate",

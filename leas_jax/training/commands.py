@@ -19,6 +19,26 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0, got {text!r}") from None
+    if not (value >= 0.0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got {text!r}")
+    return value
+
+
+def add_allow_pickle_argument(parser, what: str) -> None:
+    """`--allow-pickle`: read legacy pickle policies/checkpoints (they can run code when loaded)."""
+    parser.add_argument(
+        "--allow-pickle",
+        action="store_true",
+        help=f"also read {what} in the pickle format of earlier versions; unpickling a file can run "
+        "code from it, so only for files you trust (a warning is printed)",
+    )
+
+
 def _add_training_arguments(parser) -> None:
     from leas_jax.cli import add_ray_address_argument
     from leas_jax.training.config import PRESETS
@@ -80,6 +100,15 @@ def _add_training_arguments(parser) -> None:
         'against the walking generator on fresh poses; the README\'s "Contact generator" '
         "gives the trade)",
     )
+    parser.add_argument(
+        "--checkpoint-every",
+        type=_seconds,
+        default=None,
+        metavar="SECONDS",
+        help="wall-clock seconds between checkpoints (default 60; 0: after every logged iteration); "
+        "a checkpoint is also written at the end and on Ctrl-C",
+    )
+    add_allow_pickle_argument(parser, "checkpoints (resume, --init)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -106,6 +135,8 @@ def config_from_args(args):
         overrides["num_timesteps"] = args.timesteps
     if args.num_envs is not None:
         overrides["num_envs"] = args.num_envs
+    if args.checkpoint_every is not None:
+        overrides["checkpoint_every_s"] = args.checkpoint_every
     config = preset(args.preset, mode=args.mode, **overrides)
     if args.reachability == "calibrated":
         from leas_jax.env import ReachabilityConfig
@@ -121,7 +152,12 @@ def cmd_train(args) -> int:
 
     config = config_from_args(args)
     result = train(
-        config, args.out, progress=not args.no_progress, workers=args.workers, address=args.ray_address
+        config,
+        args.out,
+        progress=not args.no_progress,
+        workers=args.workers,
+        address=args.ray_address,
+        allow_pickle=args.allow_pickle,
     )
     metrics = result.metrics
     print(
@@ -141,7 +177,7 @@ def cmd_run(args) -> int:
     if args.mode != "geometric" or args.init is not None:
         raise UsageError("leas run trains both phases itself: drop --mode and --init")
     geometric = config_from_args(args)
-    train(geometric, out / "geometric", progress=not args.no_progress)
+    train(geometric, out / "geometric", progress=not args.no_progress, allow_pickle=args.allow_pickle)
     if args.planner_steps > 0:
         overrides = {
             "num_timesteps": args.planner_steps,
@@ -156,6 +192,7 @@ def cmd_run(args) -> int:
             progress=not args.no_progress,
             workers=args.workers,
             address=args.ray_address,
+            allow_pickle=args.allow_pickle,
         )
     workers = 2 if args.workers is None else args.workers
     report = write_report(
@@ -169,12 +206,29 @@ def cmd_run(args) -> int:
     return 0
 
 
+def cmd_convert(args) -> int:
+    """`leas convert`: rewrite a run directory's pickle policy and checkpoints in the checkpoint format."""
+    from leas_jax.training.checkpoint import convert_run
+
+    if not args.allow_pickle:
+        raise UsageError(
+            "convert reads pickle files, which can run code: pass --allow-pickle to confirm you trust them"
+        )
+    for run in args.run_dir:
+        if not Path(run).is_dir():
+            raise UsageError(f"RUN_DIR: {run}: not a directory")
+    for run in args.run_dir:
+        for old, new in convert_run(Path(run)):
+            print(f"{old} -> {new}")
+    return 0
+
+
 def register(subparsers) -> None:
     train = subparsers.add_parser(
         "train",
         help="train a LeaS policy (geometric PPO)",
         description="Train a LeaS policy with Brax PPO on the training arena. "
-        "Writes config.json, checkpoints/, policy.pkl, metrics.jsonl "
+        "Writes config.json, checkpoints/, policy.ckpt, metrics.jsonl "
         "and tb/ into --out; an interrupted run resumes from its last "
         "checkpoint when started again with the same --out.",
     )
@@ -215,3 +269,14 @@ def register(subparsers) -> None:
         help="trajectories per Table II cell in the report (default 10; the paper: 60)",
     )
     run.set_defaults(func=cmd_run)
+
+    convert = subparsers.add_parser(
+        "convert",
+        help="rewrite pickle policies and checkpoints of earlier versions in the checkpoint format",
+        description="Read RUN_DIR/policy.pkl and RUN_DIR/checkpoints/step_*.pkl (pickles of earlier "
+        "versions, which can run code when loaded) and write policy.ckpt and step_*.ckpt beside them "
+        "(data only, with a checksum); the pickles are kept. Same parameters, bit for bit.",
+    )
+    convert.add_argument("run_dir", nargs="+", metavar="RUN_DIR")
+    add_allow_pickle_argument(convert, "the pickles to convert (required)")
+    convert.set_defaults(func=cmd_convert)

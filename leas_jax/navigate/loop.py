@@ -9,7 +9,7 @@ One query runs, in a closed loop with the contact generator:
 3. contact planning: the generator validates the whole guide grown so far (the verified
    prefix of the previous attempts plus the new segment; one `ValidationPool` task);
 4. where it stops short, the cells within `failure_radius` of where it failed are penalised,
-   and the search is repeated from a verified pose `backoff_seconds` before its last valid
+   and the search is repeated from a verified pose `backoff_distance` before its last valid
    posture, at most `max_replans` times.
 
 The generator plans each grown guide from its start, so the returned plan is one continuous
@@ -45,8 +45,14 @@ class NavigateConfig:
     # extra cost per m (on top of 1) of moving within failure_radius of a failure: 4 makes a
     # detour up to 5 x the length of the penalised stretch cheaper than going through again
     failure_penalty: float = 4.0
-    failure_radius: float = 0.5  # m, about a step and a half of Talos
-    backoff_seconds: float = 2.0  # s of verified guide given up before the failure (room to turn)
+    # m, about a step and a half of Talos. The penalised disk is centred failure_radius / 2
+    # ahead of the guide pose where the generator failed, along its heading: what stopped it
+    # (a foothold it could not find) lies ahead of the root, and the pose the search starts
+    # again from (backoff_distance before) then lies outside the disk.
+    failure_radius: float = 0.5
+    # m of verified guide given up before the failure: room for the policy to turn away (it
+    # turns at most omega_max = 0.35 rad/s while walking, a quarter turn takes ~0.5-0.8 m)
+    backoff_distance: float = 1.0
     # LeaS horizon = this x the time to walk the waypoints at the target speed (eval's factor),
     # rounded up to `horizon_quantum` steps so that queries share a few compiled rollouts
     horizon_factor: float = 2.5
@@ -113,18 +119,31 @@ class Navigator:
         self.policy, self.terrain, self.config = policy, terrain, config
         self.env = policy.config.env
         self.say = progress or (lambda message: None)
-        began = time.perf_counter()
         self.field = heightfield_from_terrain(terrain, self.env)
-        self.lattice = build_lattice(
-            self.field, terrain.bounds, self.env.nominal_root_height, self.env.reachability, config.lattice
-        )
-        self.graph = graph(self.lattice, None, config.search)
-        self.lattice_seconds = time.perf_counter() - began
-        nx, ny, nh = self.lattice.shape
-        self.say(
-            f"lattice: {nx} x {ny} cells x {nh} headings at {config.lattice.resolution:g} m, "
-            f"{100 * self.lattice.node_valid.mean():.1f} % valid ({self.lattice_seconds:.2f} s)"
-        )
+        self._lattice = None
+        self.lattice_seconds = 0.0
+
+    @property
+    def lattice(self):
+        """The terrain's `Lattice` (built on first use, with the penalty-free search graph)."""
+        if self._lattice is None:
+            began = time.perf_counter()
+            cfg = self.config
+            self._lattice = build_lattice(
+                self.field,
+                self.terrain.bounds,
+                self.env.nominal_root_height,
+                self.env.reachability,
+                cfg.lattice,
+            )
+            self.graph = graph(self._lattice, None, cfg.search)
+            self.lattice_seconds = time.perf_counter() - began
+            nx, ny, nh = self._lattice.shape
+            self.say(
+                f"lattice: {nx} x {ny} cells x {nh} headings at {cfg.lattice.resolution:g} m, "
+                f"{100 * self._lattice.node_valid.mean():.1f} % valid ({self.lattice_seconds:.2f} s)"
+            )
+        return self._lattice
 
     # ---- inputs -------------------------------------------------------------------------
     def query(self, start, goal, speed: float = 0.0, via=None, name: str = "--start") -> Query:
@@ -182,13 +201,17 @@ class Navigator:
     def _route_search(self, state: _State, pose, route) -> SearchResult:
         """Search leg by leg through the route points; stops at the first leg that fails."""
         cfg = self.config.search
-        penalised = state.penalty.any()
-        adjacency = graph(self.lattice, state.penalty, cfg) if penalised else self.graph
+        lattice = self.lattice
+        adjacency = graph(lattice, state.penalty, cfg) if state.penalty.any() else self.graph
         paths, waypoints, current = [], [], np.asarray(pose, np.float64)[[0, 1, 3]]
         for point in route:
-            leg = search(self.lattice, current, point, cfg, adjacency=adjacency)
+            leg = search(lattice, current, point, cfg, adjacency=adjacency)
             paths.append(leg.path if not paths else leg.path[1:])
-            waypoints.append(leg.waypoints)
+            # a reached leg ends at the point itself (its goal node lies up to goal_radius off it,
+            # and the policy stops within switch distance of its last waypoint)
+            waypoints.append(
+                np.concatenate([leg.waypoints[:-1], point[None]]) if leg.reached else leg.waypoints
+            )
             current = leg.path[-1]
             if not leg.reached:
                 break
@@ -270,7 +293,10 @@ class Navigator:
         states = [_State(q, np.zeros(self.lattice.shape[:2])) for q in queries]
         for k, state in enumerate(states):
             began = time.perf_counter()
-            state.search = self._route_search(state, state.query.start, state.query.route)
+            try:
+                state.search = self._route_search(state, state.query.start, state.query.route)
+            except ValueError as exc:
+                raise UsageError(f"--start: {_fmt(state.query.start[[0, 1, 3]])}: {exc}") from None
             state.seconds["search"] += time.perf_counter() - began
             self._said_search(k, state)
         began = time.perf_counter()
@@ -324,10 +350,12 @@ class Navigator:
         outcome = metrics.outcome(guide, query.goal, result.coverage, last, plan=result.plan)
         if last >= 0 and (state.best is None or outcome.final_distance < state.best[0]):
             state.best = (outcome.final_distance, result.plan, guide)
+        # where the generator stopped (None: it covered the whole guide, the policy stopped short)
         failure = None
-        if not outcome.success and last >= 0:
+        if not outcome.success and 0 <= last < total - 1:
             stride = getattr(cfg.generator, "stride", None) or 5
-            failure = guide[min(last + stride, total - 1), :2] if last < total - 1 else guide[-1, :2]
+            pose = guide[min(last + stride, total - 1)]
+            failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
         state.attempts.append(
             Attempt(
                 state.segment_begin,
@@ -356,31 +384,43 @@ class Navigator:
         if len(state.attempts) > cfg.max_replans:
             if state.unreachable is not None:
                 return self._finish(state, state.unreachable, self._unreachable_text(state), k)
+            where = guide[-1, :2] if failure is None else failure
             return self._finish(
                 state,
                 reasons.REPLAN_LIMIT,
-                f"the contact generator still stops near {_fmt(failure)} after {cfg.max_replans} replans",
+                f"the contact generator still stops near {_fmt(where)} after {cfg.max_replans} replans",
                 k,
             )
-        # replan: penalise the failed region, search again from a verified pose before it
-        cells = self.lattice.position(
-            np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
-        )
-        state.penalty += cfg.failure_penalty * (
-            np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
-        )
-        begin = max(0, last - int(round(cfg.backoff_seconds / self.env.timestep)))
+        if failure is None:  # the whole guide is verified: walk on from its end
+            begin = total - 1
+        else:  # penalise the failed region, search again from a verified pose before it
+            cells = self.lattice.position(
+                np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
+            )
+            state.penalty += cfg.failure_penalty * (
+                np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
+            )
+            walked = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(guide[: last + 1, :2], axis=0).T))])
+            begin = int(np.searchsorted(walked, walked[-1] - cfg.backoff_distance, side="right")) - 1
+            begin = max(0, begin)
         pose = guide[begin]
         speed = (
             float(np.hypot(*(guide[begin, :2] - guide[begin - 1, :2])) / self.env.timestep)
             if begin > 0
             else query.speed
         )
-        self.say(
-            f"query {k}: replan {len(state.attempts)} from guide pose {begin} {_fmt(pose[:2])}, avoiding {_fmt(failure)}"
-        )
+        avoid = "walking on" if failure is None else f"avoiding {_fmt(failure)}"
+        self.say(f"query {k}: replan {len(state.attempts)} from guide pose {begin} {_fmt(pose[:2])}, {avoid}")
         began = time.perf_counter()
-        state.search = self._route_search(state, pose, self._remaining_route(query, guide[: begin + 1]))
+        try:
+            state.search = self._route_search(state, pose, self._remaining_route(query, guide[: begin + 1]))
+        except ValueError:  # the verified pose has no valid lattice node near it: nothing to search from
+            return self._finish(
+                state,
+                reasons.REPLAN_LIMIT,
+                f"no valid lattice node near the verified pose {_fmt(pose[:2])}",
+                k,
+            )
         state.seconds["search"] += time.perf_counter() - began
         self._said_search(k, state)
         began = time.perf_counter()

@@ -267,7 +267,9 @@ class Navigator:
         return query.route[index:]
 
     # ---- the loop ------------------------------------------------------------------------
-    def run(self, queries, workers: int = 0, pool=None, address: str | None = None) -> list[NavigationResult]:
+    def run(
+        self, queries, workers: int = 0, pool=None, address: str | None = None, done=None
+    ) -> list[NavigationResult]:
         """Answer every query (host). Generator tasks of different queries run in parallel.
 
         Args:
@@ -275,6 +277,8 @@ class Navigator:
             workers: contact-generator processes when no `pool` is given (0: in this process).
             pool: a `ValidationPool` of this terrain with return_plans=True, or None.
             address: Ray address for a pool made here (None: local).
+            done: None, or a function (query index, NavigationResult) -> None called as each
+                query ends.
 
         Returns:
             One `NavigationResult` per query, in order.
@@ -289,7 +293,8 @@ class Navigator:
                 address=address,
                 return_plans=True,
             ) as own:
-                return self.run(queries, pool=own)
+                return self.run(queries, pool=own, done=done)
+        self._done = done or (lambda k, result: None)
         states = [_State(q, np.zeros(self.lattice.shape[:2])) for q in queries]
         for k, state in enumerate(states):
             began = time.perf_counter()
@@ -468,6 +473,7 @@ class Navigator:
             timestep=self.env.timestep,
         )
         self.say(f"query {k}: {reason}: {text}")
+        self._done(k, state.done)
         return None
 
 

@@ -75,3 +75,49 @@ def test_a_navigate_plan_passes_verify(tmp_path, capsys):
     assert np.min(np.hypot(*(plan.q[:, :2] - [2.5, 1.6]).T)) <= 0.30
     assert main(["verify", str(out)]) == 0
     assert "OK" in capsys.readouterr().out
+
+
+SCENARIO_SLAB = """
+name = "navigate_slab"
+bounds = [[0.0, 0.0], [5.0, 3.0]]
+void_height = -2.0
+resolution = 0.02
+[[box]]
+center = [2.5, 1.5, -0.3]
+size = [5.0, 3.0, 0.6]
+[scenario]
+target = [3.8, 1.5]
+start_region = [[1.0, 1.2], [1.4, 1.8]]
+start_yaw_deg = [-30.0, 30.0]
+start_speed = [0.01, 0.05]
+n_starts = 2
+seed = 0
+"""
+
+
+def test_evaluate_adds_a_navigate_row(tmp_path):
+    import json
+
+    from leas_jax.eval.evaluate import evaluate
+
+    terrain = tmp_path / "navigate_slab.toml"
+    terrain.write_text(SCENARIO_SLAB)
+    report = evaluate(
+        [],
+        ["navigate"],
+        SHIPPED,
+        tmp_path / "out",
+        workers=0,
+        terrain_file=terrain,
+        progress=False,
+        figures=False,
+    )
+    (row,) = [r for r in report["rows"] if r["method"] == "navigate"]
+    assert row["n"] == 2 and row["success"] == 100.0 and row["errors"] == 0
+    saved = json.loads((tmp_path / "out" / "results.json").read_text())
+    trajectories = saved["scenarios"]["navigate_slab"]["trajectories"]
+    assert [t["method"] for t in trajectories] == ["navigate", "navigate"]
+    assert all(t["replans"] >= 0 and t["guide_length"] > 100 for t in trajectories)
+    assert "Navigate (lattice search, LeaS, replans)" in (tmp_path / "out" / "table.md").read_text()
+    seconds = saved["scenarios"]["navigate_slab"]["seconds"]
+    assert {"navigate", "navigate_search", "navigate_rollout", "navigate_contact_planning"} <= set(seconds)

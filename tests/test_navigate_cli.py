@@ -121,3 +121,17 @@ def test_evaluate_adds_a_navigate_row(tmp_path):
     assert "Navigate (lattice search, LeaS, replans)" in (tmp_path / "out" / "table.md").read_text()
     seconds = saved["scenarios"]["navigate_slab"]["seconds"]
     assert {"navigate", "navigate_search", "navigate_rollout", "navigate_contact_planning"} <= set(seconds)
+
+
+def test_the_report_section_runs_one_query_and_writes_its_plan_and_figure(tmp_path):
+    from leas_jax.navigate.report import navigate_section
+
+    terrain = tmp_path / "navigate_slab.toml"
+    terrain.write_text(SCENARIO_SLAB)
+    lines, summary = navigate_section(SHIPPED, tmp_path, workers=0, terrain_file=terrain)
+    assert summary["success"] and summary["postures"] > 10
+    assert lines[0] == "## Navigate" and "![navigate](navigate/navigate.png)" in lines
+    assert (tmp_path / "navigate" / "plan.npz").is_file() and (
+        tmp_path / "navigate" / "navigate.png"
+    ).is_file()
+    assert main(["verify", str(tmp_path / "navigate" / "plan.npz")]) == 0

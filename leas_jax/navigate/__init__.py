@@ -6,7 +6,8 @@
 
 Modules: lattice (the root's valid set over positions x headings, jitted), search (Dijkstra
 over the lattice), loop (closed loop with the LeaS policy and the contact generator),
-result (NavigationResult), commands (`leas navigate`). Attributes are imported lazily so
+result (NavigationResult), commands (`leas navigate`), report (a navigate query as a
+report section). Attributes are imported lazily so
 that `import leas_jax.navigate` (and the CLI's parser) loads no JAX.
 """
 

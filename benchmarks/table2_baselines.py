@@ -20,13 +20,17 @@ and two diagnostics of the generator's turning:
 
   --sweep-steps    RBLin's in-place rotation over fewer steps (a faster turn in
                    place) on the 150..210 degree cells of `--sweep-speeds`;
+  --generator-strides  RBKino's guides judged again by generators that plan every
+                   k-th guide pose (`GeneratorConfig.stride`, default 5: every 0.5 s;
+                   HPP's contact generator samples the guide every 0.01 s,
+                   hpp-rbprm-corba scenarios/abstract_contact_generator.py `dt`);
   per guide        the root's yaw change over the first 0.5 s (the generator's first
                    planning pose, `GeneratorConfig.stride` x timestep) and the largest
                    one within any 0.5 s, next to its coverage.
 
     nice -n 10 python benchmarks/table2_baselines.py --out docs/results/2026-12-01-table2-baselines \\
         [--n-starts 60] [--workers 2] [--variants rblin,rbkino,rbkino_cruise] \\
-        [--sweep-steps 5,10,20,50] [--sweep-speeds 0.04]
+        [--sweep-steps 5,10,20,50] [--sweep-speeds 0.04] [--generator-strides 1]
 
 Writes <out>/table2_baselines.json (per cell and variant: n, mean coverage with a 95 %
 bootstrap interval, fully covered and success fractions with 95 % Wilson intervals, the
@@ -109,6 +113,22 @@ def summarize(trajectories) -> dict:
     }
 
 
+def turn_separation(records: list[dict], variant: str) -> dict:
+    """Largest 0.5 s yaw change (deg) of the fully covered guides against the smallest of the
+    guides covered under half: `separated` when every covered one turns less than every failed one."""
+    full = [t["max_turn_deg"] for t in records if t["variant"] == variant and t["coverage"] >= 1.0]
+    failed = [t["max_turn_deg"] for t in records if t["variant"] == variant and t["coverage"] < 0.5]
+    covered_max = max(full) if full else math.nan
+    failed_min = min(failed) if failed else math.nan
+    return {
+        "covered_max": covered_max,
+        "failed_min": failed_min,
+        "n_covered": len(full),
+        "n_failed": len(failed),
+        "separated": bool(full and failed and covered_max < failed_min),
+    }
+
+
 def build(jobs, terrain, field, cells, n_starts: int, base, env):
     """Trajectories of every job (label, method, config overrides, cell indices), unvalidated."""
     from leas_jax.eval.evaluate import Trajectory
@@ -142,6 +162,35 @@ def build(jobs, terrain, field, cells, n_starts: int, base, env):
     return out
 
 
+def judge(terrain, trajectories, timestep: float, workers: int, stride: int | None) -> None:
+    """Fill every trajectory's outcome: `evaluate.validate` (stride None: the generator's
+    defaults), else one pool whose generator plans every `stride`-th guide pose."""
+    import concurrent.futures
+
+    from leas_jax.contacts import GeneratorConfig, ValidationPool
+    from leas_jax.eval import metrics
+    from leas_jax.eval.evaluate import validate
+
+    if stride is None:
+        validate(terrain, trajectories, timestep, workers, progress=True, desc="table II baselines")
+        return
+    target = np.asarray(terrain.scenario.target, np.float64)
+    config = GeneratorConfig(stride=stride)
+    with ValidationPool(terrain, workers=workers, config=config, return_plans=True) as pool:
+        futures = {pool.submit([t.guide], timestep): t for t in trajectories}
+        for future in concurrent.futures.as_completed(futures):
+            t = futures[future]
+            (result,) = future.result()
+            t.outcome = metrics.outcome(
+                t.guide,
+                target,
+                result.coverage,
+                result.last_valid_index,
+                plan=result.plan,
+                error=result.error,
+            )
+
+
 def figure(report: dict, path: Path) -> None:
     """Coverage vs start yaw offset (ours vs paper), coverage vs first-0.5 s turn, RBLin turn-rate sweep."""
     import matplotlib
@@ -154,10 +203,15 @@ def figure(report: dict, path: Path) -> None:
     cells = report["cells"]
     speeds = sorted({c["speed"] for c in cells})
     colours = dict(zip(speeds, ("tab:blue", "tab:orange", "tab:green")))
-    table = [v for v in ("rblin", "rbkino", "rbkino_cruise", "rbkino_vmax030") if v in report["table"]]
-    fig, axes = plt.subplots(1, len(table) + 2, figsize=(4.2 * (len(table) + 2), 4.0))
+    table = list(report["table"])
+    ncols = 4
+    nrows = -(-(len(table) + 2) // ncols)
+    fig, grid = plt.subplots(nrows, ncols, figsize=(4.3 * ncols, 3.9 * nrows), squeeze=False)
+    axes = list(grid.ravel())
+    for ax in axes[len(table) + 2 :]:
+        ax.axis("off")
     for ax, variant in zip(axes, table):
-        method = VARIANTS[variant][0]
+        method = report["variants"][variant]["method"]
         for v in speeds:
             rows = [(c, report["table"][variant][c["name"]]) for c in cells if c["speed"] == v]
             x = np.array([0.5 * sum(c["yaw_deg"]) for c, _ in rows]) + 4 * (speeds.index(v) - 1)
@@ -166,7 +220,7 @@ def figure(report: dict, path: Path) -> None:
             ax.errorbar(x, y, yerr=err, fmt="o-", color=colours[v], label=f"ours {v:g} m/s", capsize=3)
             paper = [c["paper"].get(method) for c, _ in rows]
             ax.plot(x, paper, "x--", color=colours[v], alpha=0.7, label=f"paper {v:g} m/s")
-        ax.set_title(variant)
+        ax.set_title(report["variants"][variant]["title"], fontsize=9)
         ax.set_xlabel("start yaw offset from the target direction (deg)")
         ax.set_xticks([0, 90, 180])
         ax.set_ylim(-5, 105)
@@ -174,7 +228,7 @@ def figure(report: dict, path: Path) -> None:
     axes[0].set_ylabel("mean coverage of the contact plan (%)")
     axes[0].legend(fontsize=7)
     ax = axes[len(table)]
-    for variant, marker in (("rbkino", "o"), ("rbkino_cruise", "^"), ("rbkino_vmax030", "s"), ("rblin", ".")):
+    for variant, marker in zip(table, "o^sDv.*"):
         points = [t for t in report["trajectories"] if t["variant"] == variant]
         if points:
             ax.scatter(
@@ -188,6 +242,9 @@ def figure(report: dict, path: Path) -> None:
     ax.set_xlabel("largest root yaw change within 0.5 s (deg)")
     ax.set_ylabel("coverage (%)")
     ax.set_title("fast turns: the generator's limit")
+    for variant, gap in report["turn_separation"].items():
+        if variant == "rbkino" and gap["separated"]:
+            ax.axvline(gap["failed_min"], color="k", lw=0.8, ls=":")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     ax = axes[len(table) + 1]
@@ -202,6 +259,10 @@ def figure(report: dict, path: Path) -> None:
         if paper is not None:
             ax.plot([18.0], [paper], "kx", ms=10, label=f"paper RBLin (100 steps), {v:g} m/s")
     ax.set_xscale("log")
+    rates = sorted({r["deg_per_s"] for r in sweep.values()})
+    ax.set_xticks(rates)
+    ax.set_xticklabels([f"{r:.0f}" for r in rates], fontsize=7, rotation=60)
+    ax.minorticks_off()
     ax.set_xlabel("RBLin in-place turn rate for 180 deg (deg/s)")
     ax.set_ylabel("mean coverage (%)")
     ax.set_title("turning in place")
@@ -228,6 +289,9 @@ def main(argv=None) -> None:
         "--sweep-steps", default="5,10,20,50", help="RBLin rotation steps to sweep ('' for none)"
     )
     parser.add_argument("--sweep-speeds", default="0.04", help="initial speeds (m/s) of the swept cells")
+    parser.add_argument(
+        "--generator-strides", default="", help="generator strides re-judging RBKino's guides ('' for none)"
+    )
     args = parser.parse_args(argv)
     variants = parse_list(args.variants, str, "--variants")
     unknown = [v for v in variants if v not in VARIANTS]
@@ -237,11 +301,11 @@ def main(argv=None) -> None:
         )
     steps = parse_list(args.sweep_steps, int, "--sweep-steps")
     sweep_speeds = parse_list(args.sweep_speeds, float, "--sweep-speeds")
-    if args.n_starts < 1 or args.workers < 0 or any(s < 1 for s in steps):
-        raise UsageError("--n-starts and --sweep-steps must be >= 1, --workers >= 0")
+    strides = parse_list(args.generator_strides, int, "--generator-strides")
+    if args.n_starts < 1 or args.workers < 0 or any(s < 1 for s in steps + strides):
+        raise UsageError("--n-starts, --sweep-steps and --generator-strides must be >= 1, --workers >= 0")
 
     from leas_jax.env import EnvConfig, heightfield_from_terrain
-    from leas_jax.eval.evaluate import validate
     from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for, scenario_file
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.terrain import load_terrain
@@ -260,9 +324,34 @@ def main(argv=None) -> None:
         raise UsageError(f"--sweep-speeds {args.sweep_speeds}: none of Table II's speeds")
     jobs += [(f"rblin_steps{s}", "rblin", {"rotation_steps": s}, back) for s in steps]
     trajectories = build(jobs, terrain, field, cells, args.n_starts, base, env)
+    rejudged = {}
+    for stride in strides:
+        label = f"rbkino_stride{stride}"
+        rejudged[stride] = build(
+            [(label, "rbkino", {}, all_cells)], terrain, field, cells, args.n_starts, base, env
+        )
     built = time.perf_counter()
-    validate(terrain, trajectories, base.timestep, args.workers, progress=True, desc="table II baselines")
+    judge(terrain, trajectories, base.timestep, args.workers, None)
+    for stride, extra in rejudged.items():
+        judge(terrain, extra, base.timestep, args.workers, stride)
+        trajectories += extra
     validated = time.perf_counter()
+    titles = {
+        "rblin": "RBLin (100 rotation steps)",
+        "rbkino": "RBKino, HPP synchronisation (default)",
+        "rbkino_cruise": "RBKino, former synchronisation (+-a_max)",
+        "rbkino_vmax030": "RBKino, HPP Talos vMax 0.30 m/s",
+    }
+    described = {
+        v: {"method": VARIANTS[v][0], "overrides": VARIANTS[v][1], "title": titles[v]} for v in variants
+    }
+    for stride in strides:
+        described[f"rbkino_stride{stride}"] = {
+            "method": "rbkino",
+            "overrides": {},
+            "generator_stride": stride,
+            "title": f"RBKino (HPP), generator planning every {stride} pose(s)",
+        }
 
     def rows(label, k):
         return [t for t in trajectories if t.method == label and t.cell == k]
@@ -280,7 +369,8 @@ def main(argv=None) -> None:
             }
             for c in cells
         ],
-        "table": {v: {cells[k].name: summarize(rows(v, k)) for k in all_cells} for v in variants},
+        "variants": described,
+        "table": {v: {cells[k].name: summarize(rows(v, k)) for k in all_cells} for v in described},
         "rblin_sweep": {},
         "paper_150_210": {
             f"{c.speed[0]:g}": PAPER_TABLE_II[c.table_key]["rblin"]
@@ -315,6 +405,7 @@ def main(argv=None) -> None:
         }
         for t in trajectories
     ]
+    report["turn_separation"] = {v: turn_separation(report["trajectories"], v) for v in described}
     report["seconds"] = {"guides": built - began, "contact_planning": validated - built}
     report["machine"] = {**machine(), "load_average_1min_before": load_before}
     report["time"] = time.strftime("%Y-%m-%dT%H:%M:%S")
@@ -326,11 +417,11 @@ def main(argv=None) -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(args.out / "table2_baselines.json", json.dumps(report, indent=1) + "\n")
     figure(report, args.out / "table2_baselines.png")
-    for v in variants:
-        print(v)
+    for v in described:
+        print(v, report["turn_separation"][v])
         for c in cells:
             r = report["table"][v][c.name]
-            paper = PAPER_TABLE_II.get(c.table_key, {}).get(VARIANTS[v][0])
+            paper = PAPER_TABLE_II.get(c.table_key, {}).get(described[v]["method"])
             print(
                 f"  {c.name:28s} coverage {r['coverage']:5.1f}% [{r['coverage_95ci'][0]:5.1f}, "
                 f"{r['coverage_95ci'][1]:5.1f}]  full {r['fully_covered']:5.1f}%  paper {paper}"

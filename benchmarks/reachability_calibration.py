@@ -50,7 +50,7 @@ at the repository root, reused with --reuse when the poses and the fingerprint o
 contact generator's sources, leas_jax/contacts/*.py, match).
 
 Default: 48 000 poses (the walking truth's held-out third then holds ~4 400 feasible
-poses, +-0.6 % on a sensitivity at 95 %; with the 12 000 poses of the earlier calibration,
+poses, +-0.6 % on a sensitivity at 95 %; with the 12 000 used before commit 797a783,
 the chosen setting's 95.8 % fitting sensitivity was 94.9 % on fresh poses). On 2 cores:
 ~2.5 min of ground truth (walking; ~1.5 min static) and ~20 min of search.
 

@@ -135,8 +135,8 @@ def _outcome_chunk(poses: np.ndarray) -> np.ndarray:
         if plan.last_valid_index < 0:  # which part of the initial stance failed
             feet = [None, None]
             for s in (0, 1):
-                target, yaw = generator._nominal_placement(pose, s)
-                feet[s] = generator._first_candidate(s, pose, target, yaw, feet[1 - s])
+                target, yaw = generator.footholds.nominal_placement(pose, s)
+                feet[s] = generator.footholds.first_candidate(s, pose, target, yaw, feet[1 - s])
                 if feet[s] is None:
                     break
             out[n, 1] = feet[0] is not None and feet[1] is not None

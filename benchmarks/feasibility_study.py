@@ -72,14 +72,11 @@ def bootstrap_interval(
 
 def method_configs(method: str, seed: int, args):
     """(geometric TrainConfig, planner TrainConfig or None) of one method and seed."""
-    from leas_jax.training.config import PRESETS, TRAINING_ENV, preset
+    from leas_jax.training.config import PRESETS, TRAINING_ENV, learned_condition_env, preset
 
     env = PRESETS[args.preset].get("env", TRAINING_ENV)  # the preset's env: `quick` adds the clearance term
     if method.startswith("learned"):
-        # the learned condition reads the calibrated cylinders' margins: the field needs their rasters
-        env = dataclasses.replace(
-            env, condition="learned", learned_weights=args.weights, reachability=args.learned_reachability
-        )
+        env = learned_condition_env(env, args.weights)
     env = dataclasses.replace(env, episode_length=args.episode_length)
     planner = method.endswith("+planner")
     geometric_steps = args.geometric_steps + (0 if planner else args.planner_steps)
@@ -308,7 +305,6 @@ def _parse_ints(name: str, text: str) -> tuple[int, ...]:
 def main(argv=None) -> dict:
     from common import machine
 
-    from leas_jax.env import ReachabilityConfig
     from leas_jax.errors import UsageError
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -351,16 +347,11 @@ def main(argv=None) -> dict:
     ):
         if getattr(args, name) < 1:
             raise UsageError(f"--{name.replace('_', '-')} must be >= 1")
-    args.learned_reachability = ReachabilityConfig()  # the margins the shipped weights were fitted on
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     began = time.perf_counter()
     per_seed, timings = {m: [] for m in methods}, {}
-    settings = {
-        k: (list(v) if isinstance(v, tuple) else v)
-        for k, v in vars(args).items()
-        if k not in ("out", "learned_reachability")
-    }
+    settings = {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(args).items() if k != "out"}
     report = {}
     # seeds outer, methods inner: the report is rewritten after every run, so a study stopped
     # early holds every method for the seeds it finished

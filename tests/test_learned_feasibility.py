@@ -188,3 +188,27 @@ def test_shipped_weights_agree_with_the_generator_on_held_out_poses():
     truth = np.array([generator.plan(rc.walking_guide(p), rc.WALK_TIMESTEP).coverage >= 1.0 for p in poses])
     assert truth.any() and not truth.all()
     assert (ours == truth).mean() >= 0.70, (ours, truth)
+
+
+def test_train_command_selects_the_learned_condition():
+    """`leas train --reachability learned`: the learned condition on the calibrated cylinders'
+    margins; in planner mode refreshed on the generator's verdicts (DAgger), not in geometric mode."""
+    from leas_jax.cli import build_parser
+    from leas_jax.training.commands import config_from_args
+    from leas_jax.training.config import LEARNED_REFRESH_EVERY
+
+    parser = build_parser()
+    geometric = config_from_args(
+        parser.parse_args(["train", "--out", "r", "--preset", "smoke", "--reachability", "learned"])
+    )
+    planner = config_from_args(
+        parser.parse_args(
+            ["train", "--out", "r", "--mode", "planner", "--preset", "smoke", "--reachability", "learned"]
+        )
+    )
+    for config in (geometric, planner):
+        assert config.env.condition == "learned" and config.env.reachability == EnvConfig().reachability
+        assert config.env.learned_weights == "checkpoints/feasibility/walking.npz"
+    assert geometric.condition_refresh_every == 0 and planner.condition_refresh_every == LEARNED_REFRESH_EVERY
+    default = config_from_args(parser.parse_args(["train", "--out", "r", "--preset", "smoke"]))
+    assert default.env.condition == "cylinders"

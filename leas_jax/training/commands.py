@@ -67,13 +67,15 @@ def add_training_arguments(parser) -> None:
     )
     parser.add_argument(
         "--reachability",
-        choices=["presets", "calibrated"],
+        choices=["presets", "calibrated", "learned"],
         default="presets",
         help="condition the policy trains with (both phases): presets (the default: "
         "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
         "lookahead legs, foothold and gripper disks, 95.5 / 90.2 %% sensitivity / specificity "
         'against the walking generator on fresh poses; the README\'s "Contact generator" '
-        "gives the trade)",
+        "gives the trade) or learned (the network of checkpoints/feasibility/walking.npz, trained "
+        "on the generator's walking verdicts; in planner mode refreshed on the generator's "
+        "verdicts on the policy's guides: docs/results/2026-12-01-feasibility)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
@@ -118,6 +120,13 @@ def config_from_args(args):
 
         config = dataclasses.replace(
             config, env=dataclasses.replace(config.env, reachability=ReachabilityConfig())
+        )
+    if args.reachability == "learned":
+        from leas_jax.training.config import LEARNED_REFRESH_EVERY, learned_condition_env
+
+        refresh = LEARNED_REFRESH_EVERY if config.mode == "planner" else 0
+        config = dataclasses.replace(
+            config, env=learned_condition_env(config.env), condition_refresh_every=refresh
         )
     return config
 

@@ -49,6 +49,21 @@ TRAINING_REACHABILITY = ReachabilityConfig(trunk_bottom=-0.825, leg_top=-0.55, *
 TRAINING_ENV = EnvConfig(reachability=TRAINING_REACHABILITY)
 
 
+def learned_condition_env(env: EnvConfig, weights: str = EnvConfig.learned_weights) -> EnvConfig:
+    """`env` terminating on the learned feasibility condition (`leas_jax.env.learned_feasibility`,
+    weights `weights`) instead of its cylinders. Its reachability becomes the calibrated
+    ReachabilityConfig(): the shipped weights read those cylinders' margins (the field needs
+    their rasters; benchmarks/feasibility_condition.py fits them so)."""
+    return dataclasses.replace(
+        env, condition="learned", learned_weights=weights, reachability=ReachabilityConfig()
+    )
+
+
+# Planner mode with the learned condition: refit it on the generator's verdicts every this many
+# iterations (`TrainConfig.condition_refresh_every`, see there).
+LEARNED_REFRESH_EVERY = 4
+
+
 def resolve_data_path(path: str | Path) -> Path:
     """A data file (terrain) as given if it exists, else relative to the repository root.
 

@@ -93,3 +93,18 @@ def test_the_loop_adds_the_policys_failed_poses_and_refreshes_the_condition(tmp_
     refreshed, _ = lf.load_params(tmp_path / "run" / "condition.npz")
     assert not np.array_equal(np.asarray(refreshed["w0"]), np.asarray(params["w0"]))
     assert float(refreshed["threshold"]) > -1e9
+
+
+def test_a_run_saved_before_the_learned_condition_existed_still_resumes():
+    """config.json of an earlier version lacks the condition fields: their defaults are what it trained."""
+    import json
+
+    from leas_jax.training.loop import _config_differences
+
+    config = preset("smoke")
+    saved = json.loads(config.to_json())
+    del saved["condition_refresh_every"], saved["condition_refresh_min_poses"]
+    del saved["env"]["condition"], saved["env"]["learned_weights"]
+    assert _config_differences(saved, config) == []
+    saved["seed"] = 5
+    assert _config_differences(saved, config) == ["seed"]

@@ -40,7 +40,10 @@ RECORDING_KEYS = ("checkpoint_every_s", "keep_checkpoints")
 def _config_differences(saved: dict, config: TrainConfig) -> list[str]:
     """Top-level TrainConfig keys (outside RECORDING_KEYS) whose values differ from `saved`."""
     current = json.loads(config.to_json())
-    saved = json.loads(json.dumps(saved))  # tuples -> lists, as in config.json
+    try:  # a run saved before a field existed has its default (e.g. EnvConfig.condition)
+        saved = json.loads(TrainConfig.from_dict(saved).to_json())
+    except (UsageError, TypeError):  # keys this version does not know: compare as saved
+        saved = json.loads(json.dumps(saved))  # tuples -> lists, as in config.json
     keys = (set(saved) | set(current)) - set(RECORDING_KEYS)
     return sorted(k for k in keys if saved.get(k) != current.get(k))
 

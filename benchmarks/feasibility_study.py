@@ -250,7 +250,7 @@ def markdown(report: dict) -> str:
     lines = [
         "# Feasibility ablation",
         "",
-        f"{len(s['seeds'])} training seeds, {s['geometric_steps']} geometric + {s['planner_steps']} planner env steps "
+        f"{len(s.get('seeds_done', s['seeds']))} training seeds ({', '.join(map(str, s.get('seeds_done', s['seeds'])))}), {s['geometric_steps']} geometric + {s['planner_steps']} planner env steps "
         f"(the geometric-only methods train all of them geometrically); {s['starts']} arena starts x "
         f"{len(s['eval_seeds'])} evaluation seeds, {s['episode_length']}-step episodes. Mean [95 % interval "
         "across seeds and starts].",
@@ -330,7 +330,21 @@ def main(argv=None) -> dict:
     parser.add_argument("--scenarios", nargs="*", default=[])
     parser.add_argument("--scenario-starts", type=int, default=30)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument(
+        "--tables-only",
+        action="store_true",
+        help="rewrite the table and plot from --out's feasibility_study.json (e.g. of a study stopped early)",
+    )
     args = parser.parse_args(argv)
+    if args.tables_only:
+        path = Path(args.out) / "feasibility_study.json"
+        try:
+            report = json.loads(path.read_text())
+        except (OSError, ValueError) as error:
+            raise UsageError(f"--tables-only: cannot read {path} ({error})") from None
+        (path.parent / "feasibility_study.md").write_text(markdown(report))
+        figure(report, path.parent / "feasibility_study.png")
+        return report
     methods = tuple(m for m in args.methods.split(",") if m)
     unknown = [m for m in methods if m not in METHODS]
     if unknown:

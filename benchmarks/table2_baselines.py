@@ -50,7 +50,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import machine  # noqa: E402
+from common import load_average, save  # noqa: E402
 from reachability_validation import wilson  # noqa: E402
 
 from leas_jax.errors import UsageError  # noqa: E402
@@ -314,7 +314,7 @@ def main(argv=None) -> None:
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.terrain import load_terrain
 
-    load_before = machine()["load_average_1min"]
+    load_before = load_average()
     began = time.perf_counter()
     terrain = load_terrain(scenario_file("ground"))
     env = EnvConfig()
@@ -411,17 +411,7 @@ def main(argv=None) -> None:
     ]
     report["turn_separation"] = {v: turn_separation(report["trajectories"], v) for v in described}
     report["seconds"] = {"guides": built - began, "contact_planning": validated - built}
-    report["machine"] = {**machine(), "load_average_1min_before": load_before}
-    report["time"] = time.strftime("%Y-%m-%dT%H:%M:%S")
-
-    import json
-
-    from leas_jax.training.checkpoint import atomic_write_text
-
-    args.out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(
-        args.out / "table2_baselines.json", json.dumps(report, indent=1, allow_nan=False) + "\n"
-    )
+    save("table2_baselines", report, load_before, out=args.out)
     figure(report, args.out / "table2_baselines.png")
     for v in described:
         print(v, report["turn_separation"][v])

@@ -20,6 +20,27 @@ def positive_int(text: str) -> int:
     return value
 
 
+def non_negative_seconds(text: str) -> float:
+    """argparse type: a finite number of seconds >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0, got {text!r}") from None
+    if not (value >= 0.0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got {text!r}")
+    return value
+
+
+def add_allow_pickle_argument(parser, what: str) -> None:
+    """`--allow-pickle`: read legacy pickle policies/checkpoints (they can run code when loaded)."""
+    parser.add_argument(
+        "--allow-pickle",
+        action="store_true",
+        help=f"also read {what} in the pickle format of earlier versions; unpickling a file can run "
+        "code from it, so only for files you trust (a warning is printed)",
+    )
+
+
 def add_ray_address_argument(parser, use: str) -> None:
     """`--ray-address` of the commands that run the contact generator; `use` says what runs on Ray."""
     parser.add_argument(

@@ -25,6 +25,7 @@ def build_parser() -> argparse.ArgumentParser:
     from leas_jax import pipeline
     from leas_jax.contacts import commands as contacts_commands
     from leas_jax.eval import commands as eval_commands
+    from leas_jax.navigate import commands as navigate_commands
     from leas_jax.steering import commands as steering_commands
     from leas_jax.terrain import commands as terrain_commands
     from leas_jax.training import commands as train_commands
@@ -37,6 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     terrain_commands.register(sub)
     contacts_commands.register(sub)
     eval_commands.register(sub)
+    navigate_commands.register(sub)
     return parser
 
 

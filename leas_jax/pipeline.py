@@ -22,7 +22,7 @@ def cmd_run(args) -> int:
     if args.mode != "geometric" or args.init is not None:
         raise UsageError("leas run trains both phases itself: drop --mode and --init")
     geometric = config_from_args(args)
-    train(geometric, out / "geometric", progress=not args.no_progress)
+    train(geometric, out / "geometric", progress=not args.no_progress, allow_pickle=args.allow_pickle)
     if args.planner_steps > 0:
         overrides = {
             "num_timesteps": args.planner_steps,
@@ -37,6 +37,7 @@ def cmd_run(args) -> int:
             progress=not args.no_progress,
             workers=args.workers,
             address=args.ray_address,
+            allow_pickle=args.allow_pickle,
         )
     workers = 2 if args.workers is None else args.workers
     report = write_report(

@@ -61,7 +61,7 @@ def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
                 "--out",
                 "g.npz",
             ],
-            "no policy.pkl",
+            "no policy.ckpt",
         ),
         (["train", "--out", "x", "--terrain", "missing.toml"], "--terrain: no such file"),
         (["terrain", "show", "missing.toml", "--out", "m.png"], "missing.toml"),

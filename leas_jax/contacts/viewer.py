@@ -21,7 +21,6 @@ import base64
 import functools
 import html
 import json
-from pathlib import Path
 
 import numpy as np
 
@@ -366,11 +365,26 @@ def write_html(
         mesh_cell: vertex-clustering cell of the mesh decimation, m.
         robot: False to omit the robot (faster, much smaller).
     """
+    from leas_jax.files import atomic_write_text
+
     payload = html_payload(plan, max_postures=max_postures, mesh_cell=mesh_cell, robot=robot)
-    data = json.dumps(payload, separators=(",", ":"))
     title = html.escape(f"LeaS contact plan: {payload['name']}")
-    page = _PAGE.replace("__TITLE__", title).replace("__DATA__", data.replace("</", "<\\/"))
-    Path(path).write_text(page, encoding="utf-8")
+    page = _PAGE.replace("__TITLE__", title).replace("__DATA__", script_json(payload))
+    atomic_write_text(path, page)
+
+
+# Characters of JSON text escaped inside the page's <script>: with no "<", ">" or "&" left, no
+# string can close the element ("</script>") or open a comment ("<!--"); U+2028 and U+2029 end
+# lines in older JavaScript parsers.
+_SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+
+
+def script_json(payload) -> str:
+    """JSON text of `payload` safe to embed in an HTML <script> element (JSON.parse gives `payload` back)."""
+    text = json.dumps(payload, separators=(",", ":"))
+    for char, escape in _SCRIPT_ESCAPES.items():
+        text = text.replace(char, escape)
+    return text
 
 
 _PAGE = r"""<!DOCTYPE html>
@@ -553,9 +567,13 @@ if (robot) {
 // ---- UI
 const slider = document.getElementById("posture"), label = document.getElementById("posture-label");
 const showAll = document.getElementById("show-all"), showRobot = document.getElementById("show-robot");
-document.getElementById("info").innerHTML =
-  `<b>${DATA.name}</b>: coverage ${DATA.coverage.toFixed(3)}, last valid index ${DATA.last_valid_index}, ` +
-  `${DATA.n_postures} postures` + (robot ? ` (${robot.postures.length} stored)` : "");
+// data goes into the page as text nodes only (textContent), never parsed as HTML
+const info = document.getElementById("info"), nameNode = document.createElement("b");
+nameNode.textContent = String(DATA.name);
+info.appendChild(nameNode);
+info.appendChild(document.createTextNode(
+  `: coverage ${Number(DATA.coverage).toFixed(3)}, last valid index ${Number(DATA.last_valid_index)}, ` +
+  `${Number(DATA.n_postures)} postures` + (robot ? ` (${robot.postures.length} stored)` : "")));
 if (robot) slider.max = robot.postures.length - 1;
 else document.getElementById("robot-controls").style.display = "none";
 function updateLabel() {

@@ -32,7 +32,7 @@ def draw_trajectories(axes, terrain, trajectories, title: str = "") -> None:
             axes.plot(t.guide[: last + 1, 0], t.guide[: last + 1, 1], "-", color=SUCCESS_COLOR, linewidth=0.8)
             if last < len(t.guide) - 1:
                 axes.plot(t.guide[last:, 0], t.guide[last:, 1], "-", color=FAILED_PART_COLOR, linewidth=0.8)
-        if t.waypoints is not None and t.method in ("rbkino_rrt", "leas_rrt"):
+        if t.waypoints is not None and t.method in ("rbkino_rrt", "leas_rrt", "navigate"):
             w = np.asarray(t.waypoints)
             axes.plot(w[:, 0], w[:, 1], ".", color="black", markersize=3)
         color = SUCCESS_COLOR if (o is not None and o.success) else FAILURE_COLOR

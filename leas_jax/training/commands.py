@@ -5,7 +5,12 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-from leas_jax.arguments import add_ray_address_argument, positive_int
+from leas_jax.arguments import (
+    add_allow_pickle_argument,
+    add_ray_address_argument,
+    non_negative_seconds,
+    positive_int,
+)
 from leas_jax.errors import UsageError
 
 
@@ -71,6 +76,15 @@ def add_training_arguments(parser) -> None:
         "gives the trade)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--checkpoint-every",
+        type=non_negative_seconds,
+        default=None,
+        metavar="SECONDS",
+        help="wall-clock seconds between checkpoints (default 60; 0: after every logged iteration); "
+        "a checkpoint is also written at the end and on Ctrl-C",
+    )
+    add_allow_pickle_argument(parser, "checkpoints (resume, --init)")
 
 
 def config_from_args(args):
@@ -96,6 +110,8 @@ def config_from_args(args):
         overrides["num_timesteps"] = args.timesteps
     if args.num_envs is not None:
         overrides["num_envs"] = args.num_envs
+    if args.checkpoint_every is not None:
+        overrides["checkpoint_every_s"] = args.checkpoint_every
     config = preset(args.preset, mode=args.mode, **overrides)
     if args.reachability == "calibrated":
         from leas_jax.env import ReachabilityConfig
@@ -111,7 +127,12 @@ def cmd_train(args) -> int:
 
     config = config_from_args(args)
     result = train(
-        config, args.out, progress=not args.no_progress, workers=args.workers, address=args.ray_address
+        config,
+        args.out,
+        progress=not args.no_progress,
+        workers=args.workers,
+        address=args.ray_address,
+        allow_pickle=args.allow_pickle,
     )
     metrics = result.metrics
     print(
@@ -121,14 +142,42 @@ def cmd_train(args) -> int:
     return 0
 
 
+def cmd_convert(args) -> int:
+    """`leas convert`: rewrite a run directory's pickle policy and checkpoints in the checkpoint format."""
+    from leas_jax.training.checkpoint import convert_run
+
+    if not args.allow_pickle:
+        raise UsageError(
+            "convert reads pickle files, which can run code: pass --allow-pickle to confirm you trust them"
+        )
+    for run in args.run_dir:
+        if not Path(run).is_dir():
+            raise UsageError(f"RUN_DIR: {run}: not a directory")
+    for run in args.run_dir:
+        for old, new in convert_run(Path(run)):
+            print(f"{old} -> {new}")
+    return 0
+
+
 def register(subparsers) -> None:
     train = subparsers.add_parser(
         "train",
         help="train a LeaS policy (geometric PPO)",
         description="Train a LeaS policy with Brax PPO on the training arena. "
-        "Writes config.json, checkpoints/, policy.pkl, metrics.jsonl "
+        "Writes config.json, checkpoints/, policy.ckpt, metrics.jsonl "
         "and tb/ into --out; an interrupted run resumes from its last "
         "checkpoint when started again with the same --out.",
     )
     add_training_arguments(train)
     train.set_defaults(func=cmd_train)
+
+    convert = subparsers.add_parser(
+        "convert",
+        help="rewrite pickle policies and checkpoints of earlier versions in the checkpoint format",
+        description="Read RUN_DIR/policy.pkl and RUN_DIR/checkpoints/step_*.pkl (pickles of earlier "
+        "versions, which can run code when loaded) and write policy.ckpt and step_*.ckpt beside them "
+        "(data only, with a checksum); the pickles are kept. Same parameters, bit for bit.",
+    )
+    convert.add_argument("run_dir", nargs="+", metavar="RUN_DIR")
+    add_allow_pickle_argument(convert, "the pickles to convert (required)")
+    convert.set_defaults(func=cmd_convert)

@@ -9,7 +9,8 @@ the slow tier). `make test` lists the 30 slowest tests after each run.
 The session's processes (this one, CLI subprocesses, notebook kernels) share one JAX
 compilation cache, made for the session and removed after it: many tests train or roll out
 the same tiny configs, and a program compiled once loads from the cache in the next test
-(a second identical `train` call took 24 s instead of 86 s under a load of 20 on 2 cores).
+(benchmarks/compile_cache.py: identical `train` calls after the first took 0.089 of their
+time without it, docs/results/2026-12-01-test-compile-cache).
 A JAX_COMPILATION_CACHE_DIR set by the caller is used as it is and kept.
 """
 

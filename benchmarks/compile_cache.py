@@ -1,4 +1,4 @@
-"""What the test session's JAX compilation cache saves (tests/conftest.py).
+"""What the JAX compilation cache of a test run saves (tests/conftest.py).
 
 The tests train the same tiny configs many times, each `train` call building and jitting
 its own program. This script makes the same `train` call three times in one process,

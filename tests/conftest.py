@@ -6,8 +6,8 @@ marked `@pytest.mark.slow` in its file, or listed in `SLOW_TIER` here: tests tha
 again, on more inputs, what a fast test already checks (their assertions all still run in
 the slow tier). `make test` lists the 30 slowest tests after each run.
 
-The session's processes (this one, CLI subprocesses, notebook kernels) share one JAX
-compilation cache, made for the session and removed after it: many tests train or roll out
+The processes of a test run (pytest's, CLI subprocesses, notebook kernels) share one JAX
+compilation cache, made for the run and removed after it: many tests train or roll out
 the same tiny configs, and a program compiled once loads from the cache in the next test
 (benchmarks/compile_cache.py: identical `train` calls after the first took 0.089 of their
 time without it, docs/results/2026-12-01-test-compile-cache).
@@ -34,7 +34,7 @@ SLOW_TIER = {
 
 
 def pytest_configure(config):
-    """Give the session its compilation cache (JAX reads the variable when it is imported;
+    """Give the test run its compilation cache (JAX reads the variable when it is imported;
     subprocesses inherit it)."""
     if os.environ.get(_CACHE_ENV):
         return

@@ -110,37 +110,18 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
         path: output .png file.
         dpi: resolution of the figure.
     """
-    import matplotlib
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import Polygon
 
+    from leas_jax.plotting import agg_figure, draw_heightmap
+
     terrain = _terrain_of(plan)
-    heights = terrain.raster()
     (xmin, ymin), (xmax, ymax) = terrain.bounds
-    res = terrain.resolution
     width = 8.0
     height = max(3.0, min(12.0, width * (ymax - ymin) / (xmax - xmin)))
-    fig = Figure(figsize=(width + 1.5, height), dpi=dpi)
-    FigureCanvasAgg(fig)
+    fig = agg_figure(width + 1.5, height, dpi=dpi)
     ax = fig.add_subplot(1, 1, 1)
-    # Holes (void) are masked and drawn dark blue: with the void 2 m below the
-    # ground, a shared colour scale would flatten all real relief to one grey.
-    void = heights <= terrain.void_height + 1e-6
-    solid = heights[~void]
-    low, high = (float(solid.min()), float(solid.max())) if solid.size else (0.0, 1.0)
-    cmap = matplotlib.colormaps["gray"].with_extremes(bad="#0b1a33")
-    # heights[i, j] is at (xmin + i*res, ymin + j*res): transpose so rows are y.
-    image = ax.imshow(
-        np.ma.masked_array(heights, void).T,
-        origin="lower",
-        cmap=cmap,
-        interpolation="nearest",
-        vmin=low - 0.25 - 0.5 * (high - low),
-        vmax=high + 0.05,
-        extent=(xmin - res / 2, xmax + res / 2, ymin - res / 2, ymax + res / 2),
-    )
+    image = draw_heightmap(ax, terrain, "footsteps")
     fig.colorbar(image, ax=ax, label="terrain height (m); dark blue: hole", fraction=0.04)
     for foot, _, corners in footprints(plan):
         color = FOOT_COLORS[foot]

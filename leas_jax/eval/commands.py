@@ -125,7 +125,7 @@ def cmd_arena_check(args) -> int:
 def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_more: str = "") -> None:
     """--methods, --checkpoint, --allow-pickle, --n-starts, --workers, --no-progress and --out of the
     commands that run scenarios."""
-    from leas_jax.training.commands import add_allow_pickle_argument
+    from leas_jax.arguments import add_allow_pickle_argument
 
     parser.add_argument(
         "--methods",
@@ -155,7 +155,7 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
 
 
 def register(subparsers) -> None:
-    from leas_jax.cli import add_ray_address_argument
+    from leas_jax.arguments import add_ray_address_argument
 
     parser = subparsers.add_parser(
         "evaluate",
@@ -205,7 +205,7 @@ def register(subparsers) -> None:
     _add_run_arguments(sweep, ",".join(DEFAULT_METHODS), "width")
     sweep.set_defaults(func=cmd_hole_sweep)
 
-    from leas_jax.training.commands import add_allow_pickle_argument
+    from leas_jax.arguments import add_allow_pickle_argument
 
     check = subparsers.add_parser(
         "arena-check",

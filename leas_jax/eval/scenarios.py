@@ -17,8 +17,8 @@ import numpy as np
 from leas_jax.errors import UsageError
 
 SCENARIOS = ("ground", "hole", "bridge", "stairs", "stairs_side", "circuit")
-METHODS = ("rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt")
-LEAS_METHODS = ("leas", "leas_rrt")
+METHODS = ("rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt", "navigate")
+LEAS_METHODS = ("leas", "leas_rrt", "navigate")
 RRT_METHODS = ("rbkino_rrt", "leas_rrt")
 
 # Methods the paper runs on each scenario (§IV-B, §IV-C, §IV-D).

@@ -70,44 +70,8 @@ def save_guide(path: Path, guide: np.ndarray, timestep: float, terrain_text: str
     atomic_write_bytes(path, buffer.getvalue())
 
 
-def plot_paths(terrain, paths, path: Path, title: str = "", colors=None, target=None) -> None:
-    """Top-down PNG of guide paths over the terrain heightmap.
-
-    Args:
-        terrain: the terrain (drawn with its scenario).
-        paths: list of [T, 4] guides, world.
-        path: PNG file.
-        colors: one matplotlib colour per path (default blue).
-        target: optional (x, y) drawn as a star.
-    """
-    import matplotlib.pyplot as plt
-
-    from leas_jax.terrain.commands import draw_terrain
-
-    figure = draw_terrain(terrain)
-    axes = figure.axes[0]
-    for k, guide in enumerate(paths):
-        color = colors[k] if colors is not None else "tab:blue"
-        axes.plot(guide[:, 0], guide[:, 1], "-", color=color, linewidth=1.2)
-        axes.plot(guide[0, 0], guide[0, 1], "o", color=color, markersize=4)
-        axes.arrow(
-            guide[0, 0],
-            guide[0, 1],
-            0.3 * np.cos(guide[0, 3]),
-            0.3 * np.sin(guide[0, 3]),
-            width=0.02,
-            color="black",
-        )
-    if target is not None:
-        axes.plot(*target, "*", color="red", markersize=14, markeredgecolor="black")
-    if title:
-        axes.set_title(title)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-
-
 def cmd_rollout(args) -> int:
+    from leas_jax.plotting import plot_paths
     from leas_jax.steering.leas import rollout
     from leas_jax.terrain import load_terrain
     from leas_jax.training.policy import load_policy
@@ -153,7 +117,7 @@ def cmd_rollout(args) -> int:
 
 
 def register(subparsers) -> None:
-    from leas_jax.training.commands import add_allow_pickle_argument
+    from leas_jax.arguments import add_allow_pickle_argument
 
     parser = subparsers.add_parser(
         "rollout",

@@ -112,12 +112,13 @@ def _fails_in_one_line(capsys, argv) -> str:
         ["evaluate", "--scenario", "ground", "--methods", "leas", "--n-starts", "1", "--workers", "0"],
         ["hole-sweep", "--widths", "1", "--methods", "leas", "--n-starts", "1", "--workers", "0"],
         ["arena-check", "--episodes", "4", "--seeds", "0"],
+        ["navigate", "--terrain", "terrains/eval_ground.toml", "--start", "4,4,0", "--goal", "8,4"],
     ],
-    ids=["rollout", "evaluate", "hole-sweep", "arena-check"],
+    ids=["rollout", "evaluate", "hole-sweep", "arena-check", "navigate"],
 )
 def test_policy_commands_refuse_the_hostile_policy(capsys, tmp_path, hostile, command):
     run, marker = hostile
-    out = ["--out", str(tmp_path / ("g.npz" if command[0] == "rollout" else "out"))]
+    out = ["--out", str(tmp_path / ("g.npz" if command[0] in ("rollout", "navigate") else "out"))]
     err = _fails_in_one_line(capsys, [*command, "--checkpoint", str(run), *out])
     assert "--allow-pickle" in err and not marker.exists()
 

@@ -148,3 +148,15 @@ def test_written_files_follow_the_umask(tmp_path, run_dir, umask):
         os.umask(old)
     for name in ("g.npz", "p.npz", "policy.ckpt", "c.json"):
         assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o666 & ~umask, name
+
+
+def test_n_starts_is_bounded_on_the_command_line(capsys, tmp_path):
+    from leas_jax.terrain.loader import MAX_STARTS
+
+    for command in (["evaluate", "--scenario", "ground"], ["hole-sweep"]):
+        err = _one_line_error(
+            capsys,
+            [*command, "--methods", "rblin", "--n-starts", str(MAX_STARTS + 1), "--out", str(tmp_path / "o")],
+        )
+        assert f"<= {MAX_STARTS}" in err
+    assert not (tmp_path / "o").exists()

@@ -130,3 +130,33 @@ def test_train_init_and_resume_refuse_the_hostile_checkpoint(capsys, tmp_path, h
     assert "--allow-pickle" in _fails_in_one_line(capsys, fine_tune)
     assert "--allow-pickle" in _fails_in_one_line(capsys, ["train", *small, "--out", str(run)])
     assert not marker.exists()
+
+
+def test_convert_rewrites_a_trusted_pickle_run_bit_for_bit(capsys, tmp_path, run_dir):
+    """`leas convert --allow-pickle` turns an earlier version's pickles into .ckpt files holding the
+    same arrays; without --allow-pickle it refuses."""
+    import jax
+
+    payload = checkpoint.read_policy_payload(run_dir / "policy.ckpt")
+    state = checkpoint.load_state(checkpoint.list_checkpoints(run_dir)[-1][1])
+    old = tmp_path / "old_run"
+    (old / "checkpoints").mkdir(parents=True)
+    (old / "config.json").write_text((run_dir / "config.json").read_text())
+    (old / "policy.pkl").write_bytes(pickle.dumps({**payload, "format": "leas-policy-v1"}))
+    (old / "checkpoints" / "step_000000001024.pkl").write_bytes(pickle.dumps(state))
+    assert "--allow-pickle" in _fails_in_one_line(capsys, ["convert", str(old)])
+    assert not (old / "policy.ckpt").exists()
+    assert main(["convert", "--allow-pickle", str(old)]) == 0
+    converted = load_policy(old)
+    assert converted.source.endswith("policy.ckpt")
+    original = load_policy(run_dir)
+    for a, b in zip(
+        jax.tree.leaves((original.normalizer, original.params)),
+        jax.tree.leaves((converted.normalizer, converted.params)),
+    ):
+        assert np.asarray(a).dtype == np.asarray(b).dtype
+        np.testing.assert_array_equal(a, b)
+    new_state, config = checkpoint.read_state(old / "checkpoints" / "step_000000001024.ckpt")
+    assert config == json.loads((run_dir / "config.json").read_text())
+    for a, b in zip(jax.tree.leaves(state), jax.tree.leaves(new_state)):
+        np.testing.assert_array_equal(a, b)

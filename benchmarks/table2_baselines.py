@@ -50,7 +50,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import load_average, save  # noqa: E402
+from common import load_average, provenance  # noqa: E402
 from reachability_validation import wilson  # noqa: E402
 
 from leas_jax.errors import UsageError  # noqa: E402
@@ -411,7 +411,16 @@ def main(argv=None) -> None:
     ]
     report["turn_separation"] = {v: turn_separation(report["trajectories"], v) for v in described}
     report["seconds"] = {"guides": built - began, "contact_planning": validated - built}
-    save("table2_baselines", report, load_before, out=args.out)
+    report.update(provenance(load_before))
+
+    import json
+
+    from leas_jax.training.checkpoint import atomic_write_text
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(
+        args.out / "table2_baselines.json", json.dumps(report, indent=1, allow_nan=False) + "\n"
+    )
     figure(report, args.out / "table2_baselines.png")
     for v in described:
         print(v, report["turn_separation"][v])

@@ -30,7 +30,7 @@ uses the intervals of the bang-bang family). The kinodynamic RRT (`rrt.py`)
 keeps the former synchronisation, +-a_max with a lower cruise velocity
 (`steer(..., sync="cruise")`): with HPP's, its search no longer crosses
 tests/test_steering_rrt.py's 0.30 m beam at seed 0 within that test's 3000
-iterations (HPP's curved local paths stay on a narrow beam less often).
+iterations.
 
 Decisions (document, not paper): the path starts with the initial velocity
 along the start heading (paper §IV-B: "the initial velocity direction of the

@@ -363,7 +363,8 @@ class Navigator:
             )
         last, total = int(result.last_valid_index), len(guide)
         outcome = metrics.outcome(guide, query.goal, result.coverage, last, plan=result.plan)
-        if last >= 0 and (state.best is None or outcome.final_distance < state.best[0]):
+        # the plan returned: a successful one, else the one whose valid part ends nearest the goal
+        if outcome.success or (last >= 0 and (state.best is None or outcome.final_distance < state.best[0])):
             state.best = (outcome.final_distance, result.plan, guide)
         # where the generator stopped (None: it covered the whole guide, the policy stopped short)
         failure = None

@@ -24,7 +24,7 @@ def rows():
             for method in scenario["methods"]:
                 ts = [t for t in scenario["trajectories"] if t["method"] == method]
                 k, n = sum(t["success"] for t in ts), len(ts)
-                lo, hi = wilson(k, n)
+                lo, hi = (max(0.0, v) for v in wilson(k, n))
                 replans = [t["replans"] for t in ts if "replans" in t]
                 seconds = scenario["seconds"]
                 # the RRT's search time is its own entry, shared by rbkino_rrt and leas_rrt

@@ -18,11 +18,10 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import time
 
 import numpy as np
-from common import save
+from common import load_average, save
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -66,8 +65,8 @@ def main() -> None:
     policy = load_policy("checkpoints/leas_talos")
     env = policy.config.env
     config = BaselineConfig.from_env(env)
-    load_before = os.getloadavg()
-    report = {"load_average_before": load_before, "scenarios": {}}
+    load_before = load_average()
+    report = {"scenarios": {}}
     for name in args.scenarios:
         terrain = load_terrain(scenario_file(name))
         scenario = terrain.scenario
@@ -118,8 +117,7 @@ def main() -> None:
             "rrt_over_lattice_median_time": rrt["median_s"] / lat_same["median_s"],
         }
         print(name, report["scenarios"][name], flush=True)
-    report["load_average_after"] = os.getloadavg()
-    save("navigate_search", report)
+    save("navigate_search", report, load_before)
 
 
 if __name__ == "__main__":

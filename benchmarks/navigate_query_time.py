@@ -10,7 +10,7 @@ straight 10 m guide (`plan_contacts`), so that loaded-machine figures can be sca
 
     python benchmarks/navigate_query_time.py [--queries 20] [--seed 0]
 
-Writes results/navigate_query_time.json.
+Writes <out>/navigate_query_time.json.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import math
 import time
 
 import numpy as np
-from common import load_average, save
+from common import add_out_argument, load_average, save
 
 PARTS = ("search", "rollout", "contact_planning")
 
@@ -29,6 +29,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--queries", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
+    add_out_argument(parser)
     args = parser.parse_args()
 
     from leas_jax.contacts import plan_contacts
@@ -96,7 +97,7 @@ def main() -> None:
         "rows": rows,
     }
     print({k: v for k, v in report.items() if k != "rows"})
-    save("navigate_query_time", report, load_before)
+    save("navigate_query_time", report, load_before, args.out)
 
 
 if __name__ == "__main__":

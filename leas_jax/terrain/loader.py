@@ -1,4 +1,5 @@
-"""Read and validate terrain files (TOML, docs/design.md §4 terrain format v1).
+"""Read and validate terrain files (TOML, docs/design.md §4 terrain format v1; v2 adds
+`[[mesh]]` and `[elevation]`, parsed by `leas_jax.terrain.sources`).
 
 Every rejection is a TerrainError with one line naming the file, the key and the value:
 `terrains/x.toml: box[3].size = [1.0, 0.0, 0.2]: every element must be > 0`.
@@ -13,12 +14,13 @@ from pathlib import Path
 import numpy as np
 import tomllib
 
+from leas_jax.terrain import sources
 from leas_jax.terrain.model import Box, Scenario, Terrain, TerrainError, raster_shape
 
 MAX_CELLS = 50_000_000  # docs/design.md §4: larger heightfields are rejected
 
-TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario"}
-TOP_REQUIRED = ("name", "bounds", "void_height", "resolution", "box")
+TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario"} | sources.TOP_KEYS
+TOP_REQUIRED = ("name", "bounds", "void_height", "resolution")
 BOX_KEYS = {"center", "size", "rpy"}
 BOX_REQUIRED = ("center", "size")
 SCENARIO_KEYS = {"target", "start_region", "start_yaw_deg", "start_speed", "n_starts", "seed", "waypoints"}
@@ -89,16 +91,21 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
             f"exceeds {MAX_CELLS} cells",
         )
 
-    raw_boxes = data["box"]
+    raw_boxes = data.get("box", [])
     if not isinstance(raw_boxes, list) or not all(isinstance(b, dict) for b in raw_boxes):
         check.fail("box", raw_boxes, "must be an array of tables ([[box]])")
-    if not raw_boxes:
+    if not raw_boxes and not sources.has_geometry(data):
+        if "box" not in data:
+            raise TerrainError(
+                f"{source}: box: missing required key in the top level (or [[mesh]], [elevation])"
+            )
         check.fail("box", raw_boxes, "needs at least one [[box]]")
     boxes = tuple(_box(check, f"box[{k}]", raw) for k, raw in enumerate(raw_boxes))
 
     scenario = None
     if "scenario" in data:
         scenario = _scenario(check, data["scenario"], bounds)
+    meshes, text = sources.load_sources(check, data, text, path)
     return Terrain(
         name=name,
         bounds=bounds,
@@ -108,6 +115,7 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
         scenario=scenario,
         text=text,
         path=path,
+        meshes=meshes,
     )
 
 

@@ -24,7 +24,7 @@ def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "terrain",
         help="generate, show and export terrain files",
-        description="Generate, show and export terrain files (TOML, format v1).",
+        description="Generate, show and export terrain files (TOML, format v1; v2 adds [[mesh]] and [elevation]).",
     )
     commands = parser.add_subparsers(dest="terrain_command", metavar="COMMAND", required=True)
 
@@ -182,7 +182,8 @@ def draw_terrain(terrain: Terrain):
         axes.legend(loc="upper right", fontsize=8)
     axes.set_xlabel("x (m)")
     axes.set_ylabel("y (m)")
-    axes.set_title(f"{terrain.name}: {len(terrain.boxes)} boxes, resolution {terrain.resolution:g} m")
+    parts = [f"{len(terrain.boxes)} boxes"] + ([f"{len(terrain.meshes)} meshes"] if terrain.meshes else [])
+    axes.set_title(f"{terrain.name}: {', '.join(parts)}, resolution {terrain.resolution:g} m")
     axes.set_aspect("equal")
     return figure
 

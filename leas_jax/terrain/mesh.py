@@ -479,12 +479,21 @@ def _merge(p: list, q: list, edge: tuple, flat: dict):
     merged = p_from_w + q_from_u[1:-1]
     if len(set(merged)) != len(merged):
         return None
-    scale = max(1e-9, max(math.dist(flat[a], flat[b]) for a, b in zip(merged, merged[1:] + merged[:1])))
     count = len(merged)
     for k in (merged.index(u), merged.index(w)):
-        if _cross(flat[merged[k - 1]], flat[merged[k]], flat[merged[(k + 1) % count]]) < -1e-9 * scale**2:
+        if not _convex_turn(flat[merged[k - 1]], flat[merged[k]], flat[merged[(k + 1) % count]]):
             return None
     return merged
+
+
+def _convex_turn(a, b, c) -> bool:
+    """Whether a -> b -> c turns left or goes straight on (not back: a collinear reversal
+    is the spike of two polygons glued along one side of a T)."""
+    ab = (b[0] - a[0], b[1] - a[1])
+    bc = (c[0] - b[0], c[1] - b[1])
+    cross = ab[0] * bc[1] - ab[1] * bc[0]
+    tol = 1e-9 * math.hypot(*ab) * math.hypot(*bc)
+    return cross > tol or (cross >= -tol and ab[0] * bc[0] + ab[1] * bc[1] > 0.0)
 
 
 def _drop_collinear(polygon: list, flat: dict) -> list:

@@ -27,6 +27,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
+import functools  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -107,7 +108,7 @@ def generator_case(guide_file: Path, runs: int, folder: Path) -> dict:
     for label, terrain in (("boxes", boxes), ("mesh", mesh_twin(boxes, folder))):
         generator = ContactGenerator(terrain, GeneratorConfig())
         plan = generator.plan(guide, dt)  # warm-up: caches (surfaces, collision objects)
-        cpu = sorted(_timed(lambda: generator.plan(guide, dt))[0] for _ in range(runs))
+        cpu = sorted(_timed(functools.partial(generator.plan, guide, dt))[0] for _ in range(runs))
         steps = max(footsteps(plan), 1)
         out[label] = {
             "coverage": float(plan.coverage),

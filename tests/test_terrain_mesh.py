@@ -21,7 +21,10 @@ BOX_TERRAINS = sorted(p for p in (REPO / "terrains").glob("*.toml") if "[[box]]"
 ]
 HPP_TERRAINS = sorted((REPO / "terrains").glob("hpp_*.toml"))
 HEAD = 'name = "m"\nbounds = [[-1.0, -1.0], [3.0, 2.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
-STEP = HEAD + "[[box]]\ncenter = [1.0, 0.5, -0.1]\nsize = [3.0, 2.0, 0.2]\n[[box]]\ncenter = [1.5, 0.5, 0.05]\nsize = [0.6, 0.8, 0.3]\n"
+STEP = (
+    HEAD
+    + "[[box]]\ncenter = [1.0, 0.5, -0.1]\nsize = [3.0, 2.0, 0.2]\n[[box]]\ncenter = [1.5, 0.5, 0.05]\nsize = [0.6, 0.8, 0.3]\n"
+)
 
 
 def _area(surface) -> float:
@@ -72,12 +75,17 @@ def test_round_trip_raster_and_surfaces(path, tmp_path):
     # Every mesh surface is convex and counter-clockwise about its upward normal.
     for surface in mesh.support_surfaces():
         v = surface.vertices
-        turns = np.cross(np.roll(v, -1, axis=0) - v, np.roll(v, -2, axis=0) - np.roll(v, -1, axis=0)) @ surface.normal
+        turns = (
+            np.cross(np.roll(v, -1, axis=0) - v, np.roll(v, -2, axis=0) - np.roll(v, -1, axis=0))
+            @ surface.normal
+        )
         assert np.all(turns >= -1e-9) and surface.normal[2] > 0 and surface.mesh_index == 0
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("guide", sorted((REPO / "tests" / "data").glob("*_leas_guide.npz")), ids=lambda p: p.stem)
+@pytest.mark.parametrize(
+    "guide", sorted((REPO / "tests" / "data").glob("*_leas_guide.npz")), ids=lambda p: p.stem
+)
 def test_round_trip_contact_plans(guide, tmp_path):
     from leas_jax.contacts import plan_contacts
 
@@ -101,7 +109,9 @@ def test_raster_matches_mujoco_ray_cast():
     geom = np.zeros(1, np.int32)
     rng = np.random.default_rng(0)
     for i, j in zip(rng.integers(0, len(xs), 400), rng.integers(0, len(ys), 400)):
-        dist = mujoco.mj_ray(model, data, np.array([xs[i], ys[j], 5.0]), np.array([0.0, 0.0, -1.0]), None, 1, -1, geom)
+        dist = mujoco.mj_ray(
+            model, data, np.array([xs[i], ys[j], 5.0]), np.array([0.0, 0.0, -1.0]), None, 1, -1, geom
+        )
         expected = 5.0 - dist if dist >= 0 else terrain.void_height
         assert abs(heights[i, j] - expected) < 1e-4, (xs[i], ys[j])
 
@@ -120,7 +130,9 @@ def test_defects_flipped_normals_duplicates_and_open_edges(tmp_path):
         return trimesh.Trimesh(mesh.vertices, mesh.faces[:, ::-1], process=False)
 
     def duplicated(mesh):
-        return trimesh.Trimesh(mesh.vertices, np.concatenate([mesh.faces, mesh.faces[:, [1, 2, 0]]]), process=False)
+        return trimesh.Trimesh(
+            mesh.vertices, np.concatenate([mesh.faces, mesh.faces[:, [1, 2, 0]]]), process=False
+        )
 
     def open_edges(mesh):
         # Keep the upward faces only: no sides, no bottoms, every edge open.
@@ -197,7 +209,9 @@ def test_elevation_map_of_a_known_function(tmp_path):
     )
     (tmp_path / "e.toml").write_text(text)
     terrain = load_terrain(tmp_path / "e.toml")
-    np.testing.assert_allclose(terrain.raster(), f(x[:, None], y[None, :]).astype(np.float32), atol=1e-6, rtol=0)
+    np.testing.assert_allclose(
+        terrain.raster(), f(x[:, None], y[None, :]).astype(np.float32), atol=1e-6, rtol=0
+    )
     # Between samples the surface is the grid's triangles: linear along a cell edge.
     mid = terrain.height_at([x[10] + res / 2, y[7]])
     assert mid == pytest.approx(0.5 * (f(x[10], y[7]) + f(x[11], y[7])), abs=1e-12)
@@ -249,15 +263,31 @@ def test_bad_mesh_inputs(tmp_path, monkeypatch):
     cases = [
         ('[[mesh]]\nfile = "missing.stl"\n', {}, r'mesh\[0\]\.file = "missing\.stl": cannot read'),
         ('[[mesh]]\nfile = "dir.stl"\n', {}, r'mesh\[0\]\.file = "dir\.stl": cannot read'),
-        ('[[mesh]]\nfile = "junk.obj"\n', {"junk.obj": b"\x00\x01garbage"}, r"junk\.obj.*(not a readable|no triangle)"),
-        ('[[mesh]]\nfile = "empty.obj"\n', {"empty.obj": b"v 0 0 0\nv 1 0 0\n"}, r"empty\.obj.*(no triangle|not a readable)"),
+        (
+            '[[mesh]]\nfile = "junk.obj"\n',
+            {"junk.obj": b"\x00\x01garbage"},
+            r"junk\.obj.*(not a readable|no triangle)",
+        ),
+        (
+            '[[mesh]]\nfile = "empty.obj"\n',
+            {"empty.obj": b"v 0 0 0\nv 1 0 0\n"},
+            r"empty\.obj.*(no triangle|not a readable)",
+        ),
         (
             '[[mesh]]\nfile = "nan.obj"\n',
             {"nan.obj": b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"},
             r"nan\.obj.*(nan or inf|not a readable)",
         ),
-        ('[[mesh]]\nfile = "t.stl"\nscale = 0.0\n', {"t.stl": good}, r"mesh\[0\]\.scale = 0\.0: must be non-zero"),
-        ('[[mesh]]\nfile = "t.stl"\nscale = [1.0, 0.0, 1.0]\n', {"t.stl": good}, r"mesh\[0\]\.scale = \[1\.0, 0\.0, 1\.0\]"),
+        (
+            '[[mesh]]\nfile = "t.stl"\nscale = 0.0\n',
+            {"t.stl": good},
+            r"mesh\[0\]\.scale = 0\.0: must be non-zero",
+        ),
+        (
+            '[[mesh]]\nfile = "t.stl"\nscale = [1.0, 0.0, 1.0]\n',
+            {"t.stl": good},
+            r"mesh\[0\]\.scale = \[1\.0, 0\.0, 1\.0\]",
+        ),
         ('[[mesh]]\nfile = "t.dae"\n', {}, r"mesh\[0\]\.file = \"t\.dae\": unknown file type"),
         ('[[mesh]]\nfile = "hpp-environments:../x.stl"\n', {}, r"must be relative, without '\.\.'"),
         ('[[mesh]]\nfile = "t.stl"\ncolour = 1\n', {"t.stl": good}, r"mesh\[0\]\.colour = 1: unknown key"),
@@ -321,7 +351,9 @@ def test_hpp_scenes_load_with_scenarios(path):
     terrain = load_terrain(path)
     assert terrain.meshes and terrain.meshes[0].source.startswith("hpp-environments:multicontact/")
     assert terrain.scenario is not None
-    heights = terrain.height_at(np.concatenate([terrain.scenario.start_region, terrain.scenario.target[None]]))
+    heights = terrain.height_at(
+        np.concatenate([terrain.scenario.start_region, terrain.scenario.target[None]])
+    )
     assert np.all(heights > terrain.void_height + 1.0)  # starts and target on the scene
     assert terrain.support_surfaces()
 

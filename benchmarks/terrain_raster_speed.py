@@ -91,6 +91,11 @@ def mesh_twin(terrain, folder: Path):
     return loads_terrain(text, source=str(folder / "twin.toml"), path=str(folder / "twin.toml"))
 
 
+def guide_terrain(guide_file: Path) -> Path:
+    """The terrain of a tests/data guide: eval_<scenario>_<what>_leas_guide.npz -> terrains/eval_<scenario>.toml."""
+    return REPO / "terrains" / ("_".join(guide_file.stem.split("_")[:2]) + ".toml")
+
+
 def footsteps(plan) -> int:
     """Single-support postures of a plan (one per footstep)."""
     return int(np.isnan(plan.feet[:, :, 0]).any(axis=1).sum())
@@ -99,11 +104,11 @@ def footsteps(plan) -> int:
 def generator_case(guide_file: Path, runs: int, folder: Path) -> dict:
     """CPU ms per footstep of the generator on a guide, boxes against their mesh twin."""
     from leas_jax.contacts import ContactGenerator, GeneratorConfig
-    from leas_jax.terrain import loads_terrain
+    from leas_jax.terrain import load_terrain
 
     with np.load(guide_file) as data:
-        guide, dt, text = data["guide"], float(data["timestep"]), str(data["terrain"])
-    boxes = loads_terrain(text, source=guide_file.name)
+        guide, dt = data["guide"], float(data["timestep"])
+    boxes = load_terrain(guide_terrain(guide_file))
     out = {"guide": guide_file.name, "poses": len(guide)}
     for label, terrain in (("boxes", boxes), ("mesh", mesh_twin(boxes, folder))):
         generator = ContactGenerator(terrain, GeneratorConfig())

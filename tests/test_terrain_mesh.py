@@ -82,7 +82,6 @@ def test_round_trip_raster_and_surfaces(path, tmp_path):
         assert np.all(turns >= -1e-9) and surface.normal[2] > 0 and surface.mesh_index == 0
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(
     "guide", sorted((REPO / "tests" / "data").glob("*_leas_guide.npz")), ids=lambda p: p.stem
 )
@@ -90,8 +89,9 @@ def test_round_trip_contact_plans(guide, tmp_path):
     from leas_jax.contacts import plan_contacts
 
     with np.load(guide) as data:
-        path, dt, text = data["guide"], float(data["timestep"]), str(data["terrain"])
-    boxes = loads_terrain(text)
+        path, dt = data["guide"], float(data["timestep"])
+    # eval_<scenario>_<what>_leas_guide.npz is a path on terrains/eval_<scenario>.toml
+    boxes = load_terrain(REPO / "terrains" / ("_".join(guide.stem.split("_")[:2]) + ".toml"))
     mesh = _twin(boxes, tmp_path)
     a, b = plan_contacts(boxes, path, dt), plan_contacts(mesh, path, dt)
     assert abs(a.coverage - b.coverage) <= 1.0 / len(path) + 1e-12
@@ -371,3 +371,43 @@ def test_verified_plan_on_an_hpp_scene(tmp_path):
     assert "hpp-environments:multicontact/bridge.stl" in plan.terrain and "[resolved]" in plan.terrain
     report = verify(plan)  # re-parses plan.terrain: reads the scene again and checks its hash
     assert report.ok, str(report)
+    from leas_jax.contacts.viewer import write_footsteps_png, write_html
+
+    write_html(plan, tmp_path / "plan.html", robot=False)
+    write_footsteps_png(plan, tmp_path / "plan.png")
+    html = (tmp_path / "plan.html").read_text()
+    assert len(html) > 10_000 and (tmp_path / "plan.png").stat().st_size > 10_000
+
+
+def test_env_heightfield_and_cli_on_a_mesh_scene(tmp_path):
+    from leas_jax.cli import main
+    from leas_jax.env.field import heightfield_from_terrain
+
+    path = REPO / "terrains" / "hpp_stairs.toml"
+    field = heightfield_from_terrain(load_terrain(path))
+    spawn = np.asarray(field.spawn_xy)
+    assert len(spawn) > 100
+    heights = load_terrain(path).height_at(spawn.astype(np.float64))
+    assert np.all(heights > -1.0)  # spawn points lie on the scene, not over the void
+    assert main(["terrain", "show", str(path), "--out", str(tmp_path / "s.png")]) in (0, None)
+    assert main(["terrain", "export", str(path), "--out", str(tmp_path / "s.glb")]) in (0, None)
+    assert len(trimesh.load(tmp_path / "s.glb", force="mesh").faces) == 36
+
+
+def test_verify_checks_the_mesh_hash_of_a_given_terrain(tmp_path):
+    from leas_jax.contacts import ContactPlan, verify
+
+    terrain = _twin(loads_terrain(STEP), tmp_path)
+    other = _twin(loads_terrain(STEP.replace("0.05]", "0.06]")), tmp_path, name="other")
+    plan = ContactPlan(
+        q=np.zeros((0, 39)),
+        feet=np.zeros((0, 2, 4)),
+        guide_index=np.zeros(0, dtype=np.int64),
+        last_valid_index=-1,
+        coverage=0.0,
+        terrain=terrain.text,
+        guide=np.zeros((2, 4)),
+    )
+    assert verify(plan, terrain).ok
+    report = verify(plan, other)
+    assert not report.ok and "terrain mesh[0] (other.stl): SHA-256" in str(report)

@@ -104,6 +104,22 @@ def load_sources(check, data: dict, text: str, path: str | None) -> tuple[tuple[
     return tuple(meshes), text
 
 
+def mesh_hash_mismatches(text: str, terrain) -> list[str]:
+    """Messages for the meshes of `terrain` whose SHA-256 differs from, or is missing in, the
+    `[resolved]` table of a terrain text (a plan's); [] when they all match."""
+    import tomllib
+
+    recorded = tomllib.loads(text).get("resolved", {}).get("sha256", {})
+    messages = []
+    for mesh in terrain.meshes:
+        expected = recorded.get(mesh.key)
+        if expected != mesh.sha256:
+            messages.append(
+                f"terrain {mesh.key} ({mesh.source}): SHA-256 {mesh.sha256}, the plan's terrain records {expected}"
+            )
+    return messages
+
+
 def _resolved(check, raw, path, keys) -> tuple[Path, dict]:
     """(directory of relative files, {key: expected sha256}) from `[resolved]` or the file path."""
     if raw is None:

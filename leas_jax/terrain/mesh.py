@@ -28,6 +28,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 # A vertical line exactly on a triangle edge meets the triangle (closed sets, as boxes):
 # edge functions may be this far (m) negative; far below the raster resolution.
@@ -36,8 +38,11 @@ EDGE_TOL = 1e-5  # m (float32 STL vertices at 20 m are 2e-6 m apart)
 MIN_PROJECTED_AREA = 1e-12  # m^2
 # Pairs (raster point, triangle) evaluated at once: bounds the temporaries to ~100 MB.
 _CHUNK_PAIRS = 1 << 21
-# Cell of the triangle index used by `MeshIndex.column_top` on arbitrary points.
-INDEX_CELL = 0.25  # m
+# Cell of the triangle index used by `MeshIndex.column_top` on arbitrary points: the
+# median triangle extent (so that a cell holds a few triangles), within these bounds,
+# doubled until the index holds at most INDEX_MAX_ENTRIES (triangle, cell) entries.
+INDEX_CELL_BOUNDS = (0.02, 1.0)  # m
+INDEX_MAX_ENTRIES = 1 << 24
 # Coplanar test for the grouping of mesh triangles: STL stores float32 vertices (1e-6 m
 # at 20 m), so the faces of one plane differ by more than the boxes' 1e-6 tolerances.
 COPLANAR_ANGLE = 2e-3  # rad between two adjacent triangles' normals
@@ -80,10 +85,6 @@ class TerrainMesh:
     def triangles(self) -> np.ndarray:
         """[F, 3, 3] corner positions, world, m."""
         return self.vertices[self.faces]
-
-    def aabb(self) -> np.ndarray:
-        """[2, 3] axis-aligned bounds (min row, max row), world."""
-        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
 
 
 def _edge_setup(tri: np.ndarray):
@@ -141,16 +142,12 @@ class MeshIndex:
 
     Attributes:
         triangles: [F, 3, 3] every triangle, world.
-        owner: [F] index of the mesh each triangle belongs to.
     """
 
     def __init__(self, meshes):
         meshes = tuple(meshes)
         tri = [m.triangles for m in meshes]
         self.triangles = np.concatenate(tri) if tri else np.zeros((0, 3, 3))
-        self.owner = (
-            np.concatenate([np.full(len(t), k) for k, t in enumerate(tri)]) if tri else np.zeros(0, int)
-        )
         keep, self._coeffs, self._z, self._area2 = _edge_setup(self.triangles)
         flat = self.triangles[keep]
         # Opposite-edge lengths of the projection, per corner (barycentric weights).
@@ -211,12 +208,19 @@ class MeshIndex:
 
     @functools.cached_property
     def _cells(self):
-        """Triangle index on a grid of INDEX_CELL cells: (origin [2], (cx, cy), CSR starts
-        [cx*cy + 1], triangle ids, per-cell maximum triangle height [cx*cy])."""
+        """Triangle index on a grid of square cells: (origin [2], cell side, (cx, cy), CSR
+        starts [cx*cy + 1], triangle ids, per-cell maximum triangle height [cx*cy])."""
         origin = self._lo.min(axis=0) if len(self) else np.zeros(2)
-        c0 = np.floor((self._lo - origin) / INDEX_CELL).astype(np.int64)
-        c1 = np.floor((self._hi - origin) / INDEX_CELL).astype(np.int64)
-        size = (int(c1[:, 0].max(initial=0)) + 1, int(c1[:, 1].max(initial=0)) + 1)
+        extent = np.max(self._hi - self._lo, axis=1) if len(self) else np.ones(1)
+        side = float(np.clip(np.median(extent), *INDEX_CELL_BOUNDS))
+        while True:
+            c0 = np.floor((self._lo - origin) / side).astype(np.int64)
+            c1 = np.floor((self._hi - origin) / side).astype(np.int64)
+            entries = int(np.sum((c1[:, 0] - c0[:, 0] + 1) * (c1[:, 1] - c0[:, 1] + 1)))
+            size = (int(c1[:, 0].max(initial=0)) + 1, int(c1[:, 1].max(initial=0)) + 1)
+            if entries <= INDEX_MAX_ENTRIES and size[0] * size[1] <= INDEX_MAX_ENTRIES:
+                break
+            side *= 2.0
         span_y = c1[:, 1] - c0[:, 1] + 1
         counts = (c1[:, 0] - c0[:, 0] + 1) * span_y
         t = np.repeat(np.arange(len(self)), counts)
@@ -227,12 +231,12 @@ class MeshIndex:
         starts = np.searchsorted(cell, np.arange(size[0] * size[1] + 1))
         cell_top = np.full(size[0] * size[1], -np.inf)
         np.maximum.at(cell_top, cell, self._top[t])
-        return origin, size, starts, t, cell_top
+        return origin, side, size, starts, t, cell_top
 
     def _cell_of(self, xy: np.ndarray) -> np.ndarray:
         """[N] flat index cell of points xy [N, 2], -1 outside the index."""
-        origin, size, *_ = self._cells
-        c = np.floor((xy - origin) / INDEX_CELL).astype(np.int64)
+        origin, side, size, *_ = self._cells
+        c = np.floor((xy - origin) / side).astype(np.int64)
         inside = (c[:, 0] >= 0) & (c[:, 0] < size[0]) & (c[:, 1] >= 0) & (c[:, 1] < size[1])
         return np.where(inside, c[:, 0] * size[1] + c[:, 1], -1)
 
@@ -242,7 +246,7 @@ class MeshIndex:
         top = np.full(len(xy), -np.inf)
         if len(self) == 0 or len(xy) == 0:
             return top
-        _, _, starts, tri_ids, _ = self._cells
+        _, _, _, starts, tri_ids, _ = self._cells
         cell = self._cell_of(xy)
         valid = np.flatnonzero(cell >= 0)
         counts = starts[cell[valid] + 1] - starts[cell[valid]]
@@ -260,7 +264,7 @@ class MeshIndex:
         if len(self) == 0:
             return np.full(len(xy), -np.inf)
         cell = self._cell_of(xy)
-        cell_top = self._cells[4]
+        cell_top = self._cells[5]
         return np.where(cell >= 0, cell_top[np.maximum(cell, 0)], -np.inf)
 
 
@@ -346,6 +350,10 @@ def support_polygons(meshes, mu: float, height_at) -> list[MeshSurface]:
         positions[vertex_id] = mesh.vertices
         groups = _coplanar_groups(corners, unit[ids], positions)
         for members in groups:
+            if len(members) == 1:  # most triangles of a curved surface: no merging to do
+                t = members[0]
+                out.append(MeshSurface(positions[corners[t]], unit[ids[t]], index))
+                continue
             for polygon, plane_normal in _convex_pieces(
                 corners[members], unit[ids[members]], area2[ids[members]], positions
             ):
@@ -375,20 +383,11 @@ def _coplanar_groups(corners: np.ndarray, normals: np.ndarray, positions: np.nda
     a, b = owner[:-1][same], owner[1:][same]
     # Neighbours share an edge, so their planes meet there: the angle decides.
     ok = np.einsum("ni,ni->n", normals[a], normals[b]) >= math.cos(COPLANAR_ANGLE)
-    parent = np.arange(count)
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for i, j in zip(a[ok].tolist(), b[ok].tolist()):
-        ri, rj = root(i), root(j)
-        if ri != rj:
-            parent[max(ri, rj)] = min(ri, rj)
-    roots = np.array([root(i) for i in range(count)])
-    _, label = np.unique(roots, return_inverse=True)
+    graph = coo_matrix((np.ones(int(ok.sum())), (a[ok], b[ok])), shape=(count, count))
+    _, label = connected_components(graph, directed=False)
+    # Components numbered in order of their first triangle.
+    _, first = np.unique(label, return_index=True)
+    label = np.argsort(np.argsort(first))[label]
     order = np.argsort(label, kind="stable")
     splits = np.flatnonzero(np.diff(label[order])) + 1
     return np.split(order, splits)
@@ -398,9 +397,10 @@ def _convex_pieces(corners, normals, area2, positions):
     """Convex polygons covering one coplanar group of triangles.
 
     The group's plane has the area-weighted mean normal n and passes through the
-    area-weighted centroid; corners are projected onto it. Triangles are merged across
-    their shared edges, longest edge first, whenever the merged polygon stays convex
-    (Hertel-Mehlhorn); collinear corners are then dropped.
+    area-weighted centroid; triangles with a corner farther than COPLANAR_OFFSET from it
+    stay alone (their own plane); the others' corners are projected onto it. Triangles
+    are merged across their shared edges, longest edge first, whenever the merged
+    polygon stays convex (Hertel-Mehlhorn); collinear corners are then dropped.
 
     Args:
         corners: [T, 3] vertex ids (counter-clockwise about the upward normal).

@@ -129,15 +129,24 @@ def coplanar_groups(normals: np.ndarray, offsets: np.ndarray, bbox: np.ndarray) 
             i = parent[i]
         return i
 
+    # Only faces whose offsets lie within the tolerance can share a plane: each face is
+    # compared with that window of the faces sorted by offset (a mesh terrain has
+    # thousands of faces, mostly in planes of their own), the later faces only.
+    by_offset = np.argsort(offsets, kind="stable")
+    sorted_offsets = offsets[by_offset]
+    starts = np.searchsorted(sorted_offsets, offsets - COPLANAR_OFFSET_TOL, side="left")
+    ends = np.searchsorted(sorted_offsets, offsets + COPLANAR_OFFSET_TOL, side="right")
     for i in range(count):
-        same_plane = (np.linalg.norm(normals[i + 1 :] - normals[i], axis=1) < COPLANAR_NORMAL_TOL) & (
-            np.abs(offsets[i + 1 :] - offsets[i]) < COPLANAR_OFFSET_TOL
+        window = by_offset[starts[i] : ends[i]]
+        window = np.sort(window[window > i])
+        same_plane = (np.linalg.norm(normals[window] - normals[i], axis=1) < COPLANAR_NORMAL_TOL) & (
+            np.abs(offsets[window] - offsets[i]) < COPLANAR_OFFSET_TOL
         )
         touching = np.all(
-            (bbox[i + 1 :, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[i + 1 :, 1] >= bbox[i, 0] - TOUCH_TOL),
+            (bbox[window, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[window, 1] >= bbox[i, 0] - TOUCH_TOL),
             axis=1,
         )
-        for j in i + 1 + np.flatnonzero(same_plane & touching):
+        for j in window[same_plane & touching]:
             a, b = root(i), root(int(j))
             if a != b:
                 parent[max(a, b)] = min(a, b)

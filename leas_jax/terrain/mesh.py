@@ -268,7 +268,7 @@ class MeshIndex:
         return np.where(cell >= 0, cell_top[np.maximum(cell, 0)], -np.inf)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MeshSurface:
     """A convex support polygon cut from a mesh (`support_polygons`).
 

@@ -1,25 +1,71 @@
-"""Shared helpers of the benchmark scripts: machine description and JSON output."""
+"""Shared parts of the benchmark scripts: what a figure was measured on, and its JSON output.
+
+Every benchmark's JSON carries the machine, the load average before and after the
+measurement (this machine is shared: a figure without its load is not comparable)
+and the git commit with a dirty flag. A script reads `load_average()` before it
+starts measuring and passes it to `save`, which reads it again afterwards.
+"""
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import platform
+import subprocess
 import time
 from pathlib import Path
 
+REPO = Path(__file__).resolve().parent.parent
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
+def load_average() -> dict:
+    """The host's 1-, 5- and 15-minute load averages (runnable processes, all cores together)."""
+    one, five, fifteen = os.getloadavg()
+    return {"1min": round(one, 2), "5min": round(five, 2), "15min": round(fifteen, 2)}
+
+
+def git_state(repo: Path = REPO) -> dict:
+    """Commit of `repo`'s checkout and whether its tracked files differ from it.
+
+    Returns:
+        {"commit": 40-hex str or None, "dirty": bool or None}; None when git or the
+        repository is missing (a copy of the scripts outside a checkout).
+    """
+    try:
+        commit = subprocess.run(
+            ["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+        status = subprocess.run(
+            ["git", "-C", str(repo), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return {"commit": None, "dirty": None}
+    return {"commit": commit, "dirty": bool(status.strip())}
+
+
+# read when a benchmark starts (imports this module), so that the record names the code that ran
+GIT_AT_START = git_state()
+
+
 def machine() -> dict:
-    """What the figures were measured on."""
+    """What the figures were measured on: CPU model, cores, memory, JAX backend and versions."""
     import jax
 
     cpu = platform.processor() or platform.machine()
+    memory_gib = None
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
                 cpu = line.split(":", 1)[1].strip()
+                break
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemTotal"):
+                memory_gib = round(int(line.split()[1]) / 2**20, 1)
                 break
     except OSError:
         pass
@@ -27,19 +73,48 @@ def machine() -> dict:
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
+        "memory_gib": memory_gib,
         "jax": jax.__version__,
         "backend": jax.default_backend(),
         "device_kind": getattr(device, "device_kind", str(device)),
         "python": platform.python_version(),
-        "load_average_1min": os.getloadavg()[0],
+        "system": platform.platform(),
     }
 
 
-def save(name: str, payload: dict) -> Path:
-    """Write `results/<name>.json` (with the machine and a timestamp) and return its path."""
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    payload = {"benchmark": name, "time": time.strftime("%Y-%m-%dT%H:%M:%S"), "machine": machine(), **payload}
-    path = RESULTS / f"{name}.json"
-    path.write_text(json.dumps(payload, indent=2))
-    print(f"wrote {path}")
+def add_out_argument(parser: argparse.ArgumentParser) -> None:
+    """The `--out DIR` option every benchmark takes (default benchmarks/results/)."""
+    parser.add_argument(
+        "--out", type=Path, default=RESULTS, help=f"folder of the JSON output (default {RESULTS})"
+    )
+
+
+def save(name: str, payload: dict, load_before: dict, out: Path = RESULTS) -> Path:
+    """Write `<out>/<name>.json` atomically and return its path.
+
+    Args:
+        name: benchmark name (the file's stem).
+        payload: the figures (JSON-serialisable).
+        load_before: `load_average()` read before the measurement started.
+        out: folder (created if missing).
+
+    The file holds the payload with the benchmark's name, the time, the machine, the
+    git state when the benchmark started, and the load average before and after (now).
+    """
+    record = {
+        "benchmark": name,
+        "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "machine": machine(),
+        "git": GIT_AT_START,
+        "load_average_before": load_before,
+        "load_average_after": load_average(),
+        **payload,
+    }
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{name}.json"
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(json.dumps(record, indent=2) + "\n")
+    os.replace(partial, path)
+    print(f"wrote {path} (load average {load_before['1min']} -> {record['load_average_after']['1min']})")
     return path

@@ -24,7 +24,7 @@ Times are the process's CPU time (`time.process_time`): on a shared machine it l
 out the time spent waiting for a core, which wall-clock time (also saved, `wall_*`)
 counts; the load average is saved with them.
 BLAS/OpenMP pools are limited to one thread before NumPy is imported so that the
-figures are single-core ones. Writes results/contact_planner_speed.json.
+figures are single-core ones. Writes <out>/contact_planner_speed.json.
 
     python benchmarks/contact_planner_speed.py [--runs 20] [--cases flat,uturn,stairs,arena]
         [--arena-runs 3] [--profile flat|uturn|stairs|arena]
@@ -59,7 +59,7 @@ from pathlib import Path  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
 
 from leas_jax.contacts import NOMINAL_ROOT_HEIGHT, ContactGenerator, GeneratorConfig  # noqa: E402
 from leas_jax.terrain import loads_terrain  # noqa: E402
@@ -352,6 +352,7 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--check-reference", metavar="NPZ", help="re-plan saved arena guides, compare, then exit"
     )
+    add_out_argument(parser)
     args = parser.parse_args(argv)
     if args.save_reference:
         save_reference(args.save_reference)
@@ -365,12 +366,12 @@ def main(argv=None) -> None:
     unknown = sorted(set(names) - {*CASES, "arena"})
     if unknown:
         parser.error(f"unknown case(s) {unknown}; choose from {[*CASES, 'arena']}")
-    load_before = os.getloadavg()[0]
+    load_before = load_average()
     results = {name: measure(name, args.runs) for name in CASES if name in names}
     arena = measure_arena(args.arena_runs) if "arena" in names else None
     print(
-        f"CPU ms per path ((wall) = wall-clock median), load average {load_before:.2f} before, "
-        f"{os.getloadavg()[0]:.2f} after"
+        f"CPU ms per path ((wall) = wall-clock median), load average {load_before['1min']:.2f} before, "
+        f"{load_average()['1min']:.2f} after"
     )
     summary = {}
     if results:
@@ -416,12 +417,12 @@ def main(argv=None) -> None:
             "clock": "process_time (CPU); wall_* perf_counter",
             "timestep_s": DT,
             "speed_m_s": SPEED,
-            "load_average_1min_before": load_before,
-            "load_average_1min_after": os.getloadavg()[0],
             "targets": {"flat_path_ms": PATH_TARGET_MS, "ms_per_footstep": STEP_TARGET_MS},
             "cases": results,
             **summary,
         },
+        load_before,
+        args.out,
     )
 
 

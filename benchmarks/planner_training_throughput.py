@@ -3,7 +3,7 @@
 Runs `--iterations` planner-mode iterations on the training arena (from a
 geometric run with `--init`, else from scratch) with local contact workers,
 and reports kept and rolled env steps per second and the fraction of time the
-learner waited for validation. Writes results/planner_training_throughput.json.
+learner waited for validation. Writes <out>/planner_training_throughput.json.
 
     python benchmarks/planner_training_throughput.py [--init runs/quick/geometric] [--iterations 8] [--workers 2]
 """
@@ -19,7 +19,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
 
 
 def main() -> None:
@@ -30,7 +30,9 @@ def main() -> None:
     parser.add_argument("--iterations", type=int, default=8)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--num-envs", type=int, default=64, help="episodes per batch")
+    add_out_argument(parser)
     args = parser.parse_args()
+    load_before = load_average()
     overrides = dict(num_timesteps=10**9, num_envs=args.num_envs)
     if args.init:
         overrides["init_from"] = args.init
@@ -67,7 +69,7 @@ def main() -> None:
     }
     for k, v in row.items():
         print(f"{k:22s} {v}")
-    save("planner_training_throughput", row)
+    save("planner_training_throughput", row, load_before, args.out)
 
 
 if __name__ == "__main__":

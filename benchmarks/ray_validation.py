@@ -5,9 +5,10 @@ paths) with `ValidationPool.map`, for 1 and 2 local worker processes and 1 and 2
 Ray actors on a local Ray instance (`address="local"`). Each pool is opened and
 warmed with one full batch (workers load the Talos model and the sample
 database), then timed over `--runs` batches. The results must be identical
-across backends. Writes results/ray_validation.json.
+across backends. `--backends processes` leaves Ray out (without the extra installed).
+Writes <out>/ray_validation.json.
 
-    python benchmarks/ray_validation.py [--runs 3]
+    python benchmarks/ray_validation.py [--runs 3] [--backends processes,ray]
 """
 
 from __future__ import annotations
@@ -21,8 +22,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
 
+BACKENDS = {"processes": "local processes", "ray": "local Ray actors"}
 SETTINGS = (
     ("local processes", dict(workers=1)),
     ("local processes", dict(workers=2)),
@@ -50,12 +52,21 @@ def measure(terrain, guides, timestep: float, runs: int, options: dict) -> tuple
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--backends", default="processes,ray", help="comma-separated: processes, ray")
+    add_out_argument(parser)
     args = parser.parse_args()
+    chosen = [b.strip() for b in args.backends.split(",") if b.strip()]
+    unknown = sorted(set(chosen) - set(BACKENDS))
+    if unknown or not chosen:
+        parser.error(f"--backends: unknown {unknown or chosen}; choose from {sorted(BACKENDS)}")
+    if "processes" not in chosen:
+        parser.error("--backends: processes are the reference the other backends are checked against")
+    load_before = load_average()
     from test_contacts_pool_generator import DT, GUIDES, TERRAIN
 
     guides = GUIDES * 8
     rows, reference = [], None
-    for backend, options in SETTINGS:
+    for backend, options in [s for s in SETTINGS if s[0] in {BACKENDS[b] for b in chosen}]:
         figures, results = measure(TERRAIN, guides, DT, args.runs, options)
         if reference is None:
             reference = results
@@ -67,7 +78,7 @@ def main() -> None:
             f"{len(guides)} paths in {', '.join(f'{s:.2f}' for s in figures['batch_s'])} s",
             flush=True,
         )
-    save("ray_validation", {"runs": args.runs, "rows": rows})
+    save("ray_validation", {"runs": args.runs, "backends": chosen, "rows": rows}, load_before, args.out)
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ Every pose gets host-side features (NumPy, world frame, raster of the terrain):
 
 The FPs are then put in exclusive classes (first match, in the order of `CLASSES`), each
 printed with the TPs that fall in the same class: a term removing a class costs those TPs.
-Writes results/reachability_false_positives[_<truth>].json.
+Writes <out>/reachability_false_positives[_<truth>].json.
 
     python benchmarks/reachability_false_positives.py [--truth walking] [--reuse] [--no-generator]
 """
@@ -135,8 +135,8 @@ def _outcome_chunk(poses: np.ndarray) -> np.ndarray:
         if plan.last_valid_index < 0:  # which part of the initial stance failed
             feet = [None, None]
             for s in (0, 1):
-                target, yaw = generator._nominal_placement(pose, s)
-                feet[s] = generator._first_candidate(s, pose, target, yaw, feet[1 - s])
+                target, yaw = generator.footholds.nominal_placement(pose, s)
+                feet[s] = generator.footholds.first_candidate(s, pose, target, yaw, feet[1 - s])
                 if feet[s] is None:
                     break
             out[n, 1] = feet[0] is not None and feet[1] is not None
@@ -184,7 +184,7 @@ def _band_rows(values: np.ndarray, edges, fp: np.ndarray, tp: np.ndarray) -> lis
 
 
 def main(argv=None) -> None:
-    from common import save
+    from common import add_out_argument, load_average, save
 
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
@@ -197,7 +197,9 @@ def main(argv=None) -> None:
     parser.add_argument("--truth", choices=("static", "walking"), default="walking")
     parser.add_argument("--reuse", action="store_true", help="reuse the cached ground truth if it matches")
     parser.add_argument("--no-generator", action="store_true", help="skip the generator outcome of each FP")
+    add_out_argument(parser)
     args = parser.parse_args(argv)
+    load_before = load_average()
 
     terrain = load_terrain(args.terrain)
     config = ReachabilityConfig()
@@ -313,6 +315,8 @@ def main(argv=None) -> None:
             "edge_heading": facing,
             "valid_along_guide": {"fp": int((fp & ahead).sum()), "tp": int((tp & ahead).sum())},
         },
+        load_before,
+        args.out,
     )
 
 

@@ -27,7 +27,7 @@ ground truth there (cached in .cache/ like the calibration's), and reports:
     python benchmarks/reachability_validation.py [--poses 36000] [--truth static walking]
         [--learned] [--calibration-json docs/results/.../reachability_calibration.json] [--reuse]
 
-Writes results/reachability_validation.json.
+Writes <out>/reachability_validation.json.
 """
 
 from __future__ import annotations
@@ -195,7 +195,7 @@ def _fmt(c: dict) -> str:
 
 
 def main(argv=None) -> None:
-    from common import save
+    from common import add_out_argument, load_average, save
 
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
@@ -224,7 +224,9 @@ def main(argv=None) -> None:
         default=48000,
         help="the calibration's pose count (seed 0): the learned reference's test set",
     )
+    add_out_argument(parser)
     args = parser.parse_args(argv)
+    load_before = load_average()
     if args.seed == CALIBRATION_SEED:
         parser.error("--seed 0 draws the calibration's own poses; validate on another seed")
     sizes = [int(s) for s in args.train_sizes.split(",")] if args.learned else []
@@ -296,7 +298,7 @@ def main(argv=None) -> None:
                     f"{100 * TARGET_SENSITIVITY:.0f} % test sensitivity {100 * row['specificity_at_target']:5.1f} %"
                 )
         report["truths"][truth_name] = entry
-    save("reachability_validation", report)
+    save("reachability_validation", report, load_before, args.out)
 
 
 if __name__ == "__main__":

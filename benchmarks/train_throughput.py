@@ -1,7 +1,10 @@
 """Geometric PPO throughput (env steps per second, learning included).
 
 For each preset (and optional overrides), compiles one training call, then
-times `--calls` calls. Writes results/train_throughput.json.
+times `--calls` calls. The bare reference env (`benchmarks/reference_env.py`) is
+timed at the preset's batch right before and after, and the training rate is also
+given as a ratio to the reference's (the mean of the two), which the machine's
+load moves less than env steps/s. Writes <out>/train_throughput.json.
 
     python benchmarks/train_throughput.py [--presets quick,paper] [--calls 5]
 """
@@ -10,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import statistics
 import sys
 import time
 from pathlib import Path
@@ -17,7 +21,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import jax  # noqa: E402
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
+from env_throughput import reference_steps_per_s  # noqa: E402
 
 
 def measure(config, field, calls: int) -> dict:
@@ -30,11 +35,13 @@ def measure(config, field, calls: int) -> dict:
     jax.block_until_ready(metrics)
     compile_s = time.perf_counter() - t0
     load_before = os.getloadavg()[0]
+    reference = [reference_steps_per_s(field, config.env, config.num_envs)]
     t0 = time.perf_counter()
     for _ in range(calls):
         state, metrics = call(state, field)
     jax.block_until_ready(metrics)
     run_s = time.perf_counter() - t0
+    reference.append(reference_steps_per_s(field, config.env, config.num_envs))
     load_after = os.getloadavg()[0]
     steps = calls * config.iterations_per_call * config.batch_size
     return {
@@ -48,6 +55,8 @@ def measure(config, field, calls: int) -> dict:
         "env_steps": steps,
         "env_steps_per_s": round(steps / run_s),
         "minutes_for_80M_steps": round(80e6 / (steps / run_s) / 60, 1),
+        "reference_steps_per_s": reference,
+        "ratio_to_reference": round(steps / run_s / statistics.mean(reference), 4),
         # 1-minute load average before and after the timed calls: other jobs on the machine slow it down
         "load_average_1min": [round(load_before, 2), round(load_after, 2)],
         "cpus": os.cpu_count(),
@@ -63,7 +72,9 @@ def main() -> None:
     parser.add_argument("--presets", default="quick,paper")
     parser.add_argument("--calls", type=int, default=5)
     parser.add_argument("--epochs", default="", help="also measure these num_epochs values, e.g. 10,4")
+    add_out_argument(parser)
     args = parser.parse_args()
+    load_before = load_average()
     rows = []
     for name in args.presets.split(","):
         config = preset(name)
@@ -74,12 +85,13 @@ def main() -> None:
             rows.append(row)
             print(
                 f"{name:6s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
-                f"{row['env_steps_per_s']:>10,} env steps/s, 80 M steps in {row['minutes_for_80M_steps']} min "
+                f"{row['env_steps_per_s']:>10,} env steps/s ({row['ratio_to_reference']:.3f} of the reference env's), "
+                f"80 M steps in {row['minutes_for_80M_steps']} min "
                 f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
                 f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)",
                 flush=True,
             )
-    save("train_throughput", {"rows": rows})
+    save("train_throughput", {"rows": rows}, load_before, args.out)
 
 
 if __name__ == "__main__":

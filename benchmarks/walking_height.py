@@ -13,7 +13,7 @@ condition (EnvConfig defaults) says about the same poses:
             within `--radius` (0.15 m) of the root + h.
 
 200 poses per guide (0.18 m/s, 0.1 s timestep), yaw 0. Writes
-results/walking_height.json.
+<out>/walking_height.json.
 
     python benchmarks/walking_height.py [--heights 0.8,0.85,...] [--radius 0.15]
 """
@@ -28,7 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 CASES = {
@@ -72,8 +72,10 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--radius", type=float, default=0.15, help="stairs: ground = highest within this radius, m"
     )
+    add_out_argument(parser)
     args = parser.parse_args(argv)
     heights = [float(h) for h in args.heights.split(",")]
+    load_before = load_average()
 
     import jax
 
@@ -114,6 +116,8 @@ def main(argv=None) -> int:
             "reachability": env.reachability.__dict__,
             "rows": rows,
         },
+        load_before,
+        args.out,
     )
     return 0
 

@@ -6,7 +6,7 @@ users do not pay for JAX start-up):
     from leas_jax import load_terrain, LeasEnv, TrainConfig, train, load_policy, rollout
 """
 
-import importlib
+from leas_jax.lazy import lazy_getattr
 
 __version__ = "0.1.0"
 
@@ -25,7 +25,4 @@ _LAZY = {
 __all__ = sorted(_LAZY)
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'leas_jax' has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, globals(), _LAZY)

@@ -14,18 +14,6 @@ import sys
 from leas_jax.errors import LeasError
 
 
-def add_ray_address_argument(parser, use: str) -> None:
-    """`--ray-address` of the commands that run the contact generator; `use` says what runs on Ray."""
-    parser.add_argument(
-        "--ray-address",
-        metavar="ADDRESS",
-        default=None,
-        help=f"{use} on Ray instead of local processes (pip install 'leas-jax[cluster]'): "
-        "ray://HOST:PORT (Ray client of a cluster), auto (the cluster this machine belongs "
-        "to) or local (a new local Ray instance)",
-    )
-
-
 class OneLineErrorParser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line on stderr and exit code 2 (no usage dump)."""
 
@@ -34,8 +22,10 @@ class OneLineErrorParser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from leas_jax import pipeline
     from leas_jax.contacts import commands as contacts_commands
     from leas_jax.eval import commands as eval_commands
+    from leas_jax.navigate import commands as navigate_commands
     from leas_jax.steering import commands as steering_commands
     from leas_jax.terrain import commands as terrain_commands
     from leas_jax.training import commands as train_commands
@@ -43,10 +33,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = OneLineErrorParser(prog="leas", description="LeaS: learn to steer a locomotion contact planner.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     train_commands.register(sub)
+    pipeline.register(sub)
     steering_commands.register(sub)
     terrain_commands.register(sub)
     contacts_commands.register(sub)
     eval_commands.register(sub)
+    navigate_commands.register(sub)
     return parser
 
 

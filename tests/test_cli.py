@@ -61,7 +61,7 @@ def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
                 "--out",
                 "g.npz",
             ],
-            "no policy.pkl",
+            "no policy.ckpt",
         ),
         (["train", "--out", "x", "--terrain", "missing.toml"], "--terrain: no such file"),
         (["terrain", "show", "missing.toml", "--out", "m.png"], "missing.toml"),
@@ -140,3 +140,44 @@ def test_console_script_runs():
     """The installed `leas` entry point answers --help without importing JAX errors."""
     result = subprocess.run([sys.executable, "-m", "leas_jax.cli", "--help"], capture_output=True, text=True)
     assert result.returncode == 0 and "rollout" in result.stdout and "train" in result.stdout
+
+
+# Modules whose start-up is what makes a command line slow (JAX, Brax and what they pull in).
+HEAVY = ("jax", "jaxlib", "brax", "flax", "optax", "mujoco", "pinocchio", "coal", "matplotlib", "scipy")
+
+_HELP_PROBE = """
+import contextlib, io, json, sys
+from leas_jax.cli import build_parser
+
+parser = build_parser()
+commands = sorted(parser._subparsers._group_actions[0].choices)
+answers = {}
+for argv in [["--help"], *([name, "--help"] for name in commands), ["train", "--preset", "fast", "--out", "x"]]:
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            parser.parse_args(argv)
+        except SystemExit as exit_:
+            answers[" ".join(argv)] = [exit_.code, len(out.getvalue()), err.getvalue()]
+heavy = sorted({m.split(".")[0] for m in sys.modules} & set(sys.argv[1:]))
+print(json.dumps({"commands": commands, "answers": answers, "heavy": heavy}))
+"""
+
+
+def test_help_and_argument_errors_start_no_jax():
+    """`leas --help`, every command's --help and an argument error are answered without
+    importing JAX, Brax or the other heavy libraries (what made `leas --help` take seconds)."""
+    import json
+
+    done = subprocess.run(
+        [sys.executable, "-c", _HELP_PROBE, *HEAVY], capture_output=True, text=True, timeout=120, check=True
+    )
+    probe = json.loads(done.stdout)
+    assert {"train", "run", "rollout", "plan", "verify", "show", "evaluate"} <= set(probe["commands"])
+    for argv, (code, out_chars, err) in probe["answers"].items():
+        if argv.endswith("--help"):
+            assert code == 0 and out_chars > 100, argv
+        else:
+            assert code == 2 and "invalid choice: 'fast'" in err, argv
+    assert len(probe["answers"]) == len(probe["commands"]) + 2
+    assert probe["heavy"] == []

@@ -178,11 +178,11 @@ def test_beam_lanes_only_where_the_beam_drops_on_both_sides(sides, lane):
     target = np.array(
         [3.0, 0.045, 0.0]
     )  # the left sole's nominal place under a root 4 cm right of the centre line
-    moved = generator._beam_lane(0, target, 0.0)
+    moved = generator.footholds.beam_lane(0, target, 0.0)
     expected = [3.0, 0.13 / 2 + 0.01 / 2, 0.0] if lane else target  # half a sole and half the feet gap
     np.testing.assert_allclose(moved, expected, atol=1e-9)
     # walking the other way, the left foot's lane is the other half
-    back = generator._beam_lane(0, np.array([3.0, -0.045, 0.0]), np.pi)
+    back = generator.footholds.beam_lane(0, np.array([3.0, -0.045, 0.0]), np.pi)
     np.testing.assert_allclose(back, [3.0, -0.07, 0.0] if lane else [3.0, -0.045, 0.0], atol=1e-9)
 
 
@@ -363,9 +363,11 @@ def test_start_on_rubble_tries_other_soles():
     arena = load_terrain(Path(__file__).parents[1] / "terrains" / "training_arena.toml")
     pose = np.array([2.715, 7.48, 1.046, 2.169])
     generator = ContactGenerator(arena)
-    left = generator._first_candidate(LEFT, pose, *generator._nominal_placement(pose, LEFT))
-    right = generator._first_candidate(RIGHT, pose, *generator._nominal_placement(pose, RIGHT), left)
-    assert generator._posture(pose, 0, [(LEFT, *left), (RIGHT, *right)]) is None
+    left = generator.footholds.first_candidate(LEFT, pose, *generator.footholds.nominal_placement(pose, LEFT))
+    right = generator.footholds.first_candidate(
+        RIGHT, pose, *generator.footholds.nominal_placement(pose, RIGHT), left
+    )
+    assert generator.projection.posture(pose, 0, [(LEFT, *left), (RIGHT, *right)]) is None
     plan = plan_contacts(arena, pose[None], DT)
     assert plan.last_valid_index == 0 and len(plan.q) == 1
     assert verify(plan).ok

@@ -9,8 +9,11 @@ real guides never set to these magic numbers.
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
+import subprocess
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -170,12 +173,19 @@ def test_killed_workers_are_retried_once_then_reported():
         assert result.error.startswith("WorkerDied:") and how in result.error and f"path {i}" in result.error
 
 
-def test_worker_killed_once_succeeds_on_retry(tmp_path, monkeypatch):
+def test_worker_killed_once_succeeds_on_retry(tmp_path, monkeypatch, caplog):
     # Spawned workers inherit the environment at their start.
     monkeypatch.setenv("LEAS_TEST_MARKER_DIR", str(tmp_path))
     guides = [_guide(0.1, yaw=KILL_ONCE), _guide(0.2)]
-    with ValidationPool(TERRAIN, workers=1, plan_fn=fake_plan) as pool:
-        results = pool.map(guides, 0.1, timeout=60)
+    with caplog.at_level(logging.WARNING, logger="leas_jax.contacts.validation.process"):
+        with ValidationPool(TERRAIN, workers=1, plan_fn=fake_plan) as pool:
+            killed_pid = pool._backend._pool[0].process.pid  # white-box: the first worker
+            results = pool.map(guides, 0.1, timeout=60)
+    # The death is logged, naming the worker and the path retried.
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warnings) == 1, warnings
+    assert f"pid {killed_pid} killed by SIGKILL" in warnings[0]
+    assert "path 0 (attempt 1 of 2)" in warnings[0] and "retrying" in warnings[0]
     assert (tmp_path / "killed_0.100").exists()
     assert results[0].ok and results[0].attempts == 2 and results[0].coverage == 1.0
     assert results[1].ok and results[1].attempts == 1
@@ -313,3 +323,45 @@ def test_path_seed_depends_on_index_only():
     assert path_seed(0, 3) == path_seed(0, 3)
     assert len({path_seed(0, i) for i in range(100)}) == 100
     assert path_seed(1, 3) != path_seed(0, 3)
+
+
+# A user's script that calls validate_paths at import time (no __main__ guard).
+_SCRIPT = """
+import numpy as np
+from leas_jax.contacts import validate_paths
+
+TERRAIN = {terrain!r}
+guide = np.zeros((3, 4))
+guide[:, 0] = [1.0, 1.02, 1.04]
+guide[:, 1] = 1.0
+guide[:, 2] = 1.0
+{body}
+"""
+_CALL = "results = validate_paths(TERRAIN, [guide], 0.1, workers=1)\nprint('planned', results[0].ok)"
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_a_script_without_the_main_guard_is_told_how_to_fix_it(tmp_path, guarded):
+    """Spawned workers re-import the main script: unguarded, the error names the cause and the
+    fix (the guarded script, same call, plans: the error is about the guard alone)."""
+    body = "if __name__ == '__main__':\n    " + _CALL.replace("\n", "\n    ") if guarded else _CALL
+    script = tmp_path / "validate_script.py"
+    script.write_text(_SCRIPT.format(terrain=TERRAIN, body=body))
+    root = Path(__file__).resolve().parents[1]
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")])),
+    }
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env, cwd=tmp_path
+    )
+    if guarded:
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.split() == ["planned", "True"]
+        return
+    assert done.returncode == 1 and "planned" not in done.stdout
+    last = done.stderr.strip().splitlines()
+    assert any(line.startswith("leas_jax.contacts.validation.runner.ValidationPoolError: ") for line in last)
+    assert "imports the main script again" in done.stderr
+    assert 'if __name__ == "__main__":' in done.stderr and str(script) in done.stderr
+    assert "died during start-up" not in done.stderr  # the cause, not the symptom

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from leas_jax.contacts.planner import generator as generator_module
+from leas_jax.contacts.planner import projection as projection_module
 from leas_jax.contacts.planner import surfaces as surfaces_module
 from leas_jax.contacts.planner.generator import ContactGenerator, GeneratorConfig
 from leas_jax.contacts.planner.surfaces import SOLE_CORNERS, sole_rotation
@@ -166,7 +166,7 @@ def test_flat_outside_support_fails_the_lp(talos):
         normals = np.repeat(rot[:, :, 2], 4, axis=0)
         com = np.array([*rng.uniform(-0.35, 0.35, 2), pos[0, 2] + 0.9])
         margin = flat_support_margin(points, normals, com)
-        if margin < -generator_module._OUTSIDE_MARGIN:
+        if margin < -projection_module._OUTSIDE_MARGIN:
             equilibrium.set_contacts(points, normals)
             assert equilibrium.robustness(com) < 0.0
             rejected += 1
@@ -179,9 +179,9 @@ def test_flat_outside_support_fails_the_lp(talos):
 def reference_generator(terrain, monkeypatch):
     """A generator running the slow versions of every sped-up piece."""
     monkeypatch.setattr(surfaces_module, "height_at", lambda terrain, xy: terrain.height_at(xy))
-    monkeypatch.setattr(generator_module, "_OUTSIDE_MARGIN", np.inf)
+    monkeypatch.setattr(projection_module, "_OUTSIDE_MARGIN", np.inf)
     generator = ContactGenerator(terrain, GeneratorConfig())
-    robot = generator.robot
+    robot = generator.projection.robot
     monkeypatch.setattr(
         robot,
         "terrain_contacts",

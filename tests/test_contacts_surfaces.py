@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from leas_jax.contacts.planner.generator import _rotz
+from leas_jax.contacts.planner.projection import rotz as _rotz
 from leas_jax.contacts.planner.surfaces import find_support, sole_inside_union, surface_arrays
 from leas_jax.terrain import loads_terrain
 

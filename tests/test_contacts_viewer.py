@@ -184,14 +184,24 @@ const glStub = new Proxy({}, {get(target, name) {
   };
 }});
 const elements = {};
+const htmlWrites = [];  // every assignment that would parse HTML (innerHTML, outerHTML)
+function node(props) {
+  const made = {style: {}, dataset: {}, children: [], textContent: "", ...props,
+    appendChild(child) { this.children.push(child); return child; }, addEventListener() {}};
+  for (const name of ["innerHTML", "outerHTML"])
+    Object.defineProperty(made, name, {set(value) { htmlWrites.push([made.id || made.tag, name, value]); }});
+  return made;
+}
 function element(id) {
-  if (!elements[id]) elements[id] = {id, style: {}, dataset: {}, value: "0", max: "0", checked: id === "show-robot",
-    textContent: "", innerHTML: "", clientWidth: 800, clientHeight: 600, width: 0, height: 0,
-    addEventListener() {}, getContext: kind => (kind === "webgl2" ? glStub : null)};
+  if (!elements[id]) elements[id] = node({id, value: "0", max: "0", checked: id === "show-robot",
+    clientWidth: 800, clientHeight: 600, width: 0, height: 0,
+    getContext: kind => (kind === "webgl2" ? glStub : null)});
   return elements[id];
 }
 element("plan-data").textContent = PLAN_JSON;
-global.document = {getElementById: element, body: element("body")};
+global.document = {getElementById: element, body: element("body"),
+  createElement: tag => node({tag}), createTextNode: text => node({tag: "#text", textContent: text}),
+  write() { htmlWrites.push(["document", "write"]); }};
 global.window = {addEventListener() {}, devicePixelRatio: 1};
 global.atob = s => Buffer.from(s, "base64").toString("binary");
 function drawsOf(from) {
@@ -237,6 +247,50 @@ console.log(JSON.stringify({first, all, rendered: element("body").dataset.render
     assert out["all"]["drawElements:TRIANGLES"] == 1 + 4 * n_geoms
     assert out["rendered"] == "2" and out["max"] == 3
     assert out["label"] == "#0 (guide index 0)"
+
+
+HOSTILE_NAME = '<img src=x onerror="require(`fs`).writeFileSync(`pwned`, `x`)"></script><!--'
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="Node.js not installed")
+def test_a_hostile_terrain_name_is_shown_as_text_only(plan, tmp_path):
+    """The terrain name reaches the page only as text: the title is escaped, the embedded JSON holds
+    no "<", and the script puts the name in a text node (no innerHTML or document.write anywhere)."""
+    hostile = ContactPlan(
+        q=plan.q,
+        feet=plan.feet,
+        guide_index=plan.guide_index,
+        last_valid_index=plan.last_valid_index,
+        coverage=plan.coverage,
+        terrain=TERRAIN.replace('name = "viewer_test"', "name = " + json.dumps(HOSTILE_NAME)),
+        guide=plan.guide,
+    )
+    path = tmp_path / "view.html"
+    viewer.write_html(hostile, path, robot=False)
+    text = path.read_text()
+    assert "<img" not in text and 'onerror="' not in text
+    assert text.count("</script>") == 2  # the JSON element's and the code's: the name closed none
+    data, code = _page_parts(text)
+    assert data["name"] == HOSTILE_NAME
+    assert re.search(r"innerHTML|outerHTML|insertAdjacentHTML|document\.write", code) is None
+    script = (
+        f"const PLAN_JSON = {json.dumps(json.dumps(data))};\n"
+        + _HARNESS
+        + code
+        + r"""
+console.log(JSON.stringify({htmlWrites, info: element("info").children.map(c => [c.tag, c.textContent])}));
+"""
+    )
+    (tmp_path / "run.js").write_text(script)
+    done = subprocess.run(
+        ["node", str(tmp_path / "run.js")], capture_output=True, text=True, timeout=60, cwd=tmp_path
+    )
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    assert out["htmlWrites"] == []
+    assert out["info"][0] == ["b", HOSTILE_NAME]
+    assert out["info"][1][0] == "#text" and out["info"][1][1].startswith(": coverage ")
+    assert not (tmp_path / "pwned").exists()
 
 
 def test_footsteps_png_shows_feet_guide_and_failed_tail(plan, tmp_path):

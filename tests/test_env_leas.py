@@ -136,3 +136,22 @@ def test_observation_velocity_is_in_the_root_frame():
     state = env.reset_to(jnp.array([2.0, 2.0, 1.0, np.pi / 2]), 0.2, target_dir=jnp.array([1.0, 0.0]))
     np.testing.assert_allclose(state.obs[:3], [0.2, 0.0, 0.0], atol=1e-6)  # moving forward
     assert float(state.obs[3]) == pytest.approx(-np.pi / 2, abs=1e-6)  # target on the right
+
+
+def test_a_terrain_is_accepted_and_anything_else_is_a_type_error():
+    """`LeasEnv(load_terrain(path))` builds the heightfield; a path or an array is a TypeError
+    that says what to pass."""
+    terrain = load_terrain(Path(__file__).resolve().parent / "data" / "slab_with_wall.toml")
+    config = dataclasses.replace(EnvConfig(), episode_length=7)
+    from_terrain = LeasEnv(terrain, config)
+    built = heightfield_from_terrain(terrain, config)
+    for a, b in zip(jax.tree.leaves(from_terrain.field), jax.tree.leaves(built)):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    assert from_terrain.config is config
+    state = jax.jit(from_terrain.reset)(jax.random.PRNGKey(0))
+    assert state.obs.shape == (config.observation_size,)
+    for wrong in ("terrains/eval_ground.toml", np.zeros((10, 10))):
+        with pytest.raises(
+            TypeError, match=r"expected a Heightfield or a Terrain, got .*load_terrain\(path\)"
+        ):
+            LeasEnv(wrong)

@@ -1,5 +1,6 @@
 """Hand-computed cases for the pure functions of the environment."""
 
+import dataclasses
 import math
 
 import jax.numpy as jnp
@@ -220,16 +221,30 @@ def test_nearest_sampling_of_rasters():
 
 def test_reward_terms_by_hand():
     target = jnp.array([1.0, 0.0])
-    at_speed = reward.terms(jnp.array([0.18, 0.0, 0.0]), jnp.array(0.0), jnp.zeros(4), target, CFG)
+    field = field_of(flat(height=0.0))
+    pose = jnp.array([5.0, 5.0, 1.0, 0.0])
+    at_speed = reward.terms(field, pose, jnp.array([0.18, 0.0, 0.0]), jnp.zeros(4), target, CFG)
+    assert tuple(at_speed) == reward.NAMES  # every weight has its term, in the weights' order
     assert float(at_speed["direction"]) == pytest.approx(0.0, abs=1e-7)
     assert float(at_speed["orientation"]) == pytest.approx(0.0, abs=1e-7)
     assert float(reward.total(at_speed, CFG)) == pytest.approx(1.0)  # only alive, weight 1
     # standing still, facing +y, full actions: direction -(0.18/0.6)^2 = -0.09, orientation -(1 - 0) = -1,
     # effort_ori -(1)^2, effort_acc -(sqrt(1+1+0))^2 = -2
-    t = reward.terms(jnp.zeros(3), jnp.array(math.pi / 2), jnp.array([1.0, 1.0, 0.0, -1.0]), target, CFG)
+    facing_y = pose.at[3].set(math.pi / 2)
+    t = reward.terms(field, facing_y, jnp.zeros(3), jnp.array([1.0, 1.0, 0.0, -1.0]), target, CFG)
     assert float(t["direction"]) == pytest.approx(-0.09)
     assert float(t["orientation"]) == pytest.approx(-1.0, abs=1e-6)
     assert float(t["effort_orientation"]) == pytest.approx(-1.0)
     assert float(t["effort_acceleration"]) == pytest.approx(-2.0)
     # 1.0 * -0.09 + 0.4 * -1 + 0.1 * -1 + 0.1 * -2 + 1.0 * 1 = 0.21
     assert float(reward.total(t, CFG)) == pytest.approx(0.21, abs=1e-6)
+    # The clearance term: 0 with its weight 0, else minus the invalid fraction of six probes.
+    assert float(t["clearance"]) == 0.0
+    weighted = dataclasses.replace(CFG, rewards=dataclasses.replace(CFG.rewards, clearance=2.0))
+    low = pose.at[2].set(0.80)  # 0.80 m above flat ground: valid, but 0.10 m lower is not
+    c = reward.terms(field, low, jnp.zeros(3), jnp.zeros(4), target, weighted)
+    shortfall = reachability.clearance_shortfall(field, low, weighted.clearance_margin, weighted.reachability)
+    assert float(c["clearance"]) == pytest.approx(-float(shortfall)) and float(shortfall) > 0.0
+    assert float(reward.total(c, weighted)) == pytest.approx(
+        float(reward.total(c, CFG)) + 2.0 * float(c["clearance"])
+    )

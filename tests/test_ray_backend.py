@@ -216,7 +216,7 @@ def test_ray_client_address():
     ray_cli = os.path.join(os.path.dirname(sys.executable), "ray")
     env = {**os.environ, "RAY_AUTH_MODE": "token"}
     temp_dir = tempfile.mkdtemp(prefix="leas-ray-")  # short: Ray's socket paths must fit in 107 bytes
-    # Its own session: the head's daemons share its process group, killed as one at the end.
+    # Its own process group (start_new_session): the head's daemons share its process group, killed as one at the end.
     head = subprocess.Popen(
         [
             ray_cli,

@@ -27,8 +27,8 @@ def test_shipped_policy_is_small_and_from_the_paper_preset():
     assert pretrained.config == pretraining_config(policy.config)
     assert pretrained.env_steps >= pretrained.config.num_timesteps
     # one full-state checkpoint per phase: `leas train` resumes (or fine-tunes with --init) from them
-    assert len(list((SHIPPED / "checkpoints").glob("step_*.pkl"))) == 1
-    assert len(list((SHIPPED / "pretrain" / "checkpoints").glob("step_*.pkl"))) == 1
+    assert len(list((SHIPPED / "checkpoints").glob("step_*.ckpt"))) == 1
+    assert len(list((SHIPPED / "pretrain" / "checkpoints").glob("step_*.ckpt"))) == 1
 
 
 def test_shipped_policy_walks_to_a_target_with_a_contact_plan():

@@ -7,7 +7,7 @@ import pytest
 
 from leas_jax.env import EnvConfig, heightfield_from_terrain
 from leas_jax.steering.baselines import BaselineConfig, heading_from_velocity
-from leas_jax.steering.rbkino import min_time, rbkino, steer
+from leas_jax.steering.rbkino import fixed_time_profile, min_time, rbkino, rbkino_planar, steer
 from leas_jax.steering.rblin import rblin, rblin_planar, rblin_through
 from leas_jax.terrain import loads_terrain
 
@@ -38,12 +38,13 @@ def test_min_time_by_hand():
     assert min_time(0.0, 0.0, -0.07, 0.0, 0.18, 0.1) == pytest.approx(0.7 + 2 * math.sqrt(0.245), abs=1e-6)
 
 
-def test_rbkino_reaches_goal_at_rest_within_bounds_and_slowest_axis_time():
+@pytest.mark.parametrize("sync", ["hpp", "cruise"])
+def test_rbkino_reaches_goal_at_rest_within_bounds_and_slowest_axis_time(sync):
     rng = np.random.default_rng(3)
     for _ in range(200):
         p0, p1 = rng.uniform(-3, 3, 2), rng.uniform(-3, 3, 2)
         v0 = rng.uniform(-0.18, 0.18, 2)
-        profile = steer(p0, v0, p1, np.zeros(2), 0.18, 0.1)
+        profile = steer(p0, v0, p1, np.zeros(2), 0.18, 0.1, sync=sync)
         slowest = max(min_time(p0[k], p1[k], v0[k], 0.0, 0.18, 0.1) for k in range(2))
         assert profile.duration == pytest.approx(slowest, abs=1e-9)
         t = np.linspace(0.0, profile.duration, 4001)
@@ -61,13 +62,49 @@ def test_rbkino_reaches_goal_at_rest_within_bounds_and_slowest_axis_time():
         np.testing.assert_allclose(integral, pos, atol=2e-5)
 
 
-def test_rbkino_synchronises_with_nonzero_end_velocity():
+@pytest.mark.parametrize("sync", ["hpp", "cruise"])
+def test_rbkino_synchronises_with_nonzero_end_velocity(sync):
     # v0 = v1 = 0.1 m/s and 5 cm to go: the slowest axis (y, 3 m) lasts ~17 s, during which
     # x cannot end 5 cm ahead at 0.1 m/s with |a| <= 0.1; steer lengthens the duration instead.
-    profile = steer([0, 0], [0.1, 0.0], [0.05, 3.0], [0.1, 0.0], 0.18, 0.1)
+    profile = steer([0, 0], [0.1, 0.0], [0.05, 3.0], [0.1, 0.0], 0.18, 0.1, sync=sync)
     pos, vel = profile.state([profile.duration])
     np.testing.assert_allclose(pos[0], [0.05, 3.0], atol=1e-7)
     np.testing.assert_allclose(vel[0], [0.1, 0.0], atol=1e-7)
+
+
+def test_fixed_time_profile_by_hand():
+    # Rest to rest, 5 cm in 24 s: a triangle, T^2 a^2 - 4 d a = 0 -> a = 4 d / T^2, t1 = T / 2.
+    t1, tc, t2, a1, vc, ok = fixed_time_profile(24.0, [0.05], [0.0], [0.0], 0.18, 0.1)
+    assert ok[0] and a1[0] == pytest.approx(4 * 0.05 / 24.0**2) and t1[0] == pytest.approx(12.0)
+    assert tc[0] == 0.0 and t2[0] == pytest.approx(12.0) and vc[0] == pytest.approx(a1[0] * 12.0)
+    # 4 m in 30 s (minimum 24.02 s): the triangle would peak above v_max, so three segments
+    # coasting at 0.18 m/s with a = 2 * 0.18^2 / (2 (0.18 * 30 - 4)) = 0.0231 m/s^2.
+    t1, tc, t2, a1, vc, ok = fixed_time_profile(30.0, [4.0], [0.0], [0.0], 0.18, 0.1)
+    a = 0.18**2 / (0.18 * 30.0 - 4.0)
+    assert ok[0] and a1[0] == pytest.approx(a) and vc[0] == pytest.approx(0.18)
+    np.testing.assert_allclose([t1[0], tc[0], t2[0]], [0.18 / a, 30.0 - 0.36 / a, 0.18 / a])
+
+
+def test_rbkino_slowed_axis_decays_over_the_path_as_in_hpp():
+    # Start 0.01 m/s across the goal direction (paper Table II, 90 degrees): x lasts the minimum
+    # time T; y must end where it began, at rest, in T. HPP's eq. (20) with d = 0, v0 = 0.01,
+    # v1 = 0: T^2 a^2 + 0.02 T a - 1e-4 = 0, larger root a = -0.01 (1 + sqrt 2) / T, so y decays
+    # over the whole path (an a_max ramp would stop it within 0.1 s and turn the heading by
+    # 90 degrees in one step).
+    profile = steer([0.0, 0.0], [0.0, 0.01], [4.0, 0.0], [0.0, 0.0], 0.18, 0.1, sync="hpp")
+    T = profile.duration
+    assert T == pytest.approx(min_time(0.0, 4.0, 0.0, 0.0, 0.18, 0.1))
+    a = -0.01 * (1 + math.sqrt(2)) / T
+    assert profile.a1[1] == pytest.approx(a) and profile.a2[1] == pytest.approx(-a)
+    assert profile.t1[1] == pytest.approx(0.5 * (-0.01 / a + T)) and profile.tc[1] == 0.0
+    guide = rbkino_planar([0.0, 0.0, math.pi / 2], [4.0, 0.0], 0.01, CONFIG)
+    # at t = 0.1 s: vx = 0.01, vy = 0.01 + 0.1 a -> heading ~44.7 degrees, not ~0
+    assert guide[1, 2] == pytest.approx(math.atan2(0.01 + 0.1 * a, 0.01), abs=1e-9)
+    assert math.degrees(guide[5, 2]) > 10.0
+    cruise = rbkino_planar([0.0, 0.0, math.pi / 2], [4.0, 0.0], 0.01, BaselineConfig(rbkino_sync="cruise"))
+    assert abs(math.degrees(cruise[1, 2])) < 1.0  # the former synchronisation: 90 degrees in 0.1 s
+    with pytest.raises(ValueError, match="sync"):
+        steer([0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [0.0, 0.0], 0.18, 0.1, sync="linear")
 
 
 def test_rbkino_guide_heading_follows_velocity_and_ends_on_goal(field):

@@ -115,15 +115,22 @@ def test_policy_file_and_errors(tmp_path, field):
     assert policy.config == tiny_config()
     action = np.asarray(policy(np.zeros((5, 81), np.float32)))
     assert action.shape == (5, 4) and np.all(np.abs(action) <= 1.0)
-    with pytest.raises(LeasError, match="no policy.pkl"):
+    with pytest.raises(LeasError, match="no policy.ckpt"):
         load_policy(tmp_path / "nowhere")
-    bad = tmp_path / "bad.pkl"
-    bad.write_bytes(pickle.dumps({"format": "other"}))
+    bad = tmp_path / "bad.ckpt"
+    bad.write_bytes(checkpoint.dumps_tree({"format": "other"}))
     with pytest.raises(LeasError, match="not a leas policy"):
         load_policy(bad)
     bad.write_bytes(b"garbage")
-    with pytest.raises(LeasError, match="cannot read policy"):
+    with pytest.raises(LeasError, match="not a leas checkpoint file"):
         load_policy(bad)
+    legacy = tmp_path / "bad.pkl"
+    legacy.write_bytes(pickle.dumps({"format": "other"}))
+    with pytest.raises(LeasError, match="not a leas policy"), pytest.warns(checkpoint.LegacyPickleWarning):
+        load_policy(legacy, allow_pickle=True)
+    legacy.write_bytes(b"garbage")
+    with pytest.raises(LeasError, match="cannot read policy"), pytest.warns(checkpoint.LegacyPickleWarning):
+        load_policy(legacy, allow_pickle=True)
 
 
 @pytest.mark.slow

@@ -15,16 +15,15 @@ surfaces, the generator), validation (worker pool, Ray backend). Beside them: pl
 Attributes are imported lazily so that `import leas_jax.contacts` stays cheap.
 """
 
-import importlib
-
 # Eager: the function `verify` must shadow the submodule of the same name, which
 # becomes a package attribute as soon as it is imported (verify.py imports only NumPy
 # at module level, so this stays cheap).
 from leas_jax.contacts.verify import VerificationReport, verify  # noqa: F401 (re-exported in __all__)
+from leas_jax.lazy import lazy_getattr
 
 _LAZY = {
     "ContactGenerator": "leas_jax.contacts.planner.generator",
-    "GeneratorConfig": "leas_jax.contacts.planner.generator",
+    "GeneratorConfig": "leas_jax.contacts.planner.config",
     "plan_contacts": "leas_jax.contacts.planner.generator",
     "ContactPlan": "leas_jax.contacts.plan",
     "PlanError": "leas_jax.contacts.plan",
@@ -38,7 +37,4 @@ _LAZY = {
 __all__ = sorted([*_LAZY, "VerificationReport", "verify"])
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'leas_jax.contacts' has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, globals(), _LAZY)

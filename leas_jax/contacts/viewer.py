@@ -21,7 +21,6 @@ import base64
 import functools
 import html
 import json
-from pathlib import Path
 
 import numpy as np
 
@@ -110,37 +109,18 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
         path: output .png file.
         dpi: resolution of the figure.
     """
-    import matplotlib
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import Polygon
 
+    from leas_jax.plotting import agg_figure, draw_heightmap
+
     terrain = _terrain_of(plan)
-    heights = terrain.raster()
     (xmin, ymin), (xmax, ymax) = terrain.bounds
-    res = terrain.resolution
     width = 8.0
     height = max(3.0, min(12.0, width * (ymax - ymin) / (xmax - xmin)))
-    fig = Figure(figsize=(width + 1.5, height), dpi=dpi)
-    FigureCanvasAgg(fig)
+    fig = agg_figure(width + 1.5, height, dpi=dpi)
     ax = fig.add_subplot(1, 1, 1)
-    # Holes (void) are masked and drawn dark blue: with the void 2 m below the
-    # ground, a shared colour scale would flatten all real relief to one grey.
-    void = heights <= terrain.void_height + 1e-6
-    solid = heights[~void]
-    low, high = (float(solid.min()), float(solid.max())) if solid.size else (0.0, 1.0)
-    cmap = matplotlib.colormaps["gray"].with_extremes(bad="#0b1a33")
-    # heights[i, j] is at (xmin + i*res, ymin + j*res): transpose so rows are y.
-    image = ax.imshow(
-        np.ma.masked_array(heights, void).T,
-        origin="lower",
-        cmap=cmap,
-        interpolation="nearest",
-        vmin=low - 0.25 - 0.5 * (high - low),
-        vmax=high + 0.05,
-        extent=(xmin - res / 2, xmax + res / 2, ymin - res / 2, ymax + res / 2),
-    )
+    image = draw_heightmap(ax, terrain, "footsteps")
     fig.colorbar(image, ax=ax, label="terrain height (m); dark blue: hole", fraction=0.04)
     for foot, _, corners in footprints(plan):
         color = FOOT_COLORS[foot]
@@ -385,11 +365,26 @@ def write_html(
         mesh_cell: vertex-clustering cell of the mesh decimation, m.
         robot: False to omit the robot (faster, much smaller).
     """
+    from leas_jax.files import atomic_write_text
+
     payload = html_payload(plan, max_postures=max_postures, mesh_cell=mesh_cell, robot=robot)
-    data = json.dumps(payload, separators=(",", ":"))
     title = html.escape(f"LeaS contact plan: {payload['name']}")
-    page = _PAGE.replace("__TITLE__", title).replace("__DATA__", data.replace("</", "<\\/"))
-    Path(path).write_text(page, encoding="utf-8")
+    page = _PAGE.replace("__TITLE__", title).replace("__DATA__", script_json(payload))
+    atomic_write_text(path, page)
+
+
+# Characters of JSON text escaped inside the page's <script>: with no "<", ">" or "&" left, no
+# string can close the element ("</script>") or open a comment ("<!--"); U+2028 and U+2029 end
+# lines in older JavaScript parsers.
+_SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028", "\u2029": "\\u2029"}
+
+
+def script_json(payload) -> str:
+    """JSON text of `payload` safe to embed in an HTML <script> element (JSON.parse gives `payload` back)."""
+    text = json.dumps(payload, separators=(",", ":"))
+    for char, escape in _SCRIPT_ESCAPES.items():
+        text = text.replace(char, escape)
+    return text
 
 
 _PAGE = r"""<!DOCTYPE html>
@@ -572,9 +567,13 @@ if (robot) {
 // ---- UI
 const slider = document.getElementById("posture"), label = document.getElementById("posture-label");
 const showAll = document.getElementById("show-all"), showRobot = document.getElementById("show-robot");
-document.getElementById("info").innerHTML =
-  `<b>${DATA.name}</b>: coverage ${DATA.coverage.toFixed(3)}, last valid index ${DATA.last_valid_index}, ` +
-  `${DATA.n_postures} postures` + (robot ? ` (${robot.postures.length} stored)` : "");
+// data goes into the page as text nodes only (textContent), never parsed as HTML
+const info = document.getElementById("info"), nameNode = document.createElement("b");
+nameNode.textContent = String(DATA.name);
+info.appendChild(nameNode);
+info.appendChild(document.createTextNode(
+  `: coverage ${Number(DATA.coverage).toFixed(3)}, last valid index ${Number(DATA.last_valid_index)}, ` +
+  `${Number(DATA.n_postures)} postures` + (robot ? ` (${robot.postures.length} stored)` : "")));
 if (robot) slider.max = robot.postures.length - 1;
 else document.getElementById("robot-controls").style.display = "none";
 function updateLabel() {

@@ -18,8 +18,8 @@ class ReachabilityConfig:
     defaults below were calibrated by benchmarks/reachability_calibration.py against
     the contact generator *walking* (`--truth walking --poses 48000`: a pose is feasible
     when the generator covers a 0.36 m straight guide from it; 48 000 poses of
-    terrains/training_arena.toml). The static truth (one double-support posture, the
-    issue's definition) lets the root down to about 0.5 m, where the generator does not walk.
+    terrains/training_arena.toml). The static truth (one balanced, collision-free
+    double-support posture) lets the root down to about 0.5 m, where the generator does not walk.
 
     Against the current generator these defaults give sensitivity 95.7 % and specificity
     90.0 % on the 48 000 poses (95.7 / 90.0 % on the two thirds the search fits, 95.6 /
@@ -28,16 +28,15 @@ class ReachabilityConfig:
     at >= 95 % sensitivity is 95.4 / 84.8 %. The three optional terms below close the gap
     and are on by default: the lookahead legs 0.30 m ahead (ground where the next steps
     land), the foothold (a sole-sized disk of even ground near each leg) and the hands
-    (the half-sitting grippers beside the trunk cylinder). The previous defaults
-    (calibrated on 12 000 poses: trunk bottom -0.70, no foothold term) gave 95.1 / 90.7 %
-    on the 48 000 poses and 94.9 / 90.9 % on the fresh ones. The README's "Contact
-    generator" section has the figures and their history.
+    (the half-sitting grippers beside the trunk cylinder).
+    docs/results/2026-11-22-reachability-48000-poses/ holds these figures;
+    docs/results/INDEX.md, "Reachability calibration", the earlier defaults and theirs.
     """
 
     # m, trunk cylinder radius: calibrated (docs/design.md §5: 0.30, talos_trunk boxes span x ±0.2, y ±0.3)
     trunk_radius: float = 0.30
     # m below the root: calibrated; the root stays 0.475 m above everything within
-    # trunk_radius (docs/design.md §5: -0.63, the hip; -0.70 in the 12 000-pose calibration); leg_top
+    # trunk_radius (docs/design.md §5: -0.63, the hip); leg_top
     # keeps it 0.75 m above the ground under the legs, the hands term clear beside it
     trunk_bottom: float = -0.475
     trunk_top: float = 0.60  # m above the root: head (no effect on a heightfield, which has no overhangs)
@@ -51,8 +50,8 @@ class ReachabilityConfig:
     leg_top: float = (
         -0.75
     )  # m below the root: highest reachable sole height, calibrated (docs/design.md §5: -0.54)
-    # Optional terms (benchmarks/reachability_false_positives.py, issue 3 item 6). The
-    # calibration turns all three on.
+    # Optional terms (benchmarks/reachability_false_positives.py finds the false positives
+    # they target). The calibration turns all three on.
     # m, lookahead: a second pair of leg cylinders at (leg_forward, ±leg_lateral_offset) in the
     # root frame (same radius and band) must touch too: ground where the next steps land.
     # 0 disables it. Calibrated: 0.30 m (the walking truth covers a 0.36 m guide).
@@ -126,8 +125,8 @@ class EnvConfig:
     # m/s^2 per unit of a_z; None: a_max, one bound for the three axes. The paper gives
     # no vertical bound; HPP's Talos path planners bound x and y by aMax and z apart,
     # by Kinodynamic/verticalAccelerationBound (3.0 in hpp-rbprm-corba's talos scenarios,
-    # 10.0 in older scripts). The effort reward stays in action units. The README's
-    # "The environment" section gives its effect.
+    # 10.0 in older scripts). The effort reward stays in action units. Its effect on
+    # arena validity: docs/results/INDEX.md, "Environment".
     vertical_a_max: float | None = None
     omega_max: float = math.pi / 9.0  # rad/s, thesis of the first author
     # Actions accelerate the root in its own (yaw-rotated) frame. The paper says
@@ -143,7 +142,8 @@ class EnvConfig:
     stop_at_target: bool = False  # evaluation mode: end an episode when the root is within epsilon
     # m, shift of the clearance term's six probe poses (used when rewards.clearance != 0);
     # 0.10 m kept quick policies' arena validity >= 92 % at two training seeds where 0.08 m
-    # gave 89.1 % once and 0.12 m slowed them to 0.13 m/s (README, "Training")
+    # gave 89.1 % once and 0.12 m slowed them to 0.13 m/s (docs/results/INDEX.md,
+    # "The clearance term")
     clearance_margin: float = 0.10
     reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
     reachability: ReachabilityConfig = field(default_factory=ReachabilityConfig)

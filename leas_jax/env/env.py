@@ -22,7 +22,8 @@ with contextlib.redirect_stdout(io.StringIO()):
 
 from leas_jax.env import heightmap, kinematics, reachability, reward
 from leas_jax.env.config import EnvConfig
-from leas_jax.env.field import Heightfield, sample_bilinear
+from leas_jax.env.field import Heightfield, heightfield_from_terrain, sample_bilinear
+from leas_jax.terrain.model import Terrain
 
 
 @struct.dataclass
@@ -74,7 +75,23 @@ class LeasEnv(Env):
     within `target_reached_distance` of the target point.
     """
 
-    def __init__(self, field: Heightfield, config: EnvConfig = EnvConfig()):
+    def __init__(self, field: Heightfield | Terrain, config: EnvConfig = EnvConfig()):
+        """Args:
+        field: the terrain's `Heightfield` (`heightfield_from_terrain`), or a loaded
+            `Terrain` (`load_terrain(path)`), whose heightfield is then built here (host-side,
+            once; build it yourself to share it between envs or configs).
+        config: the MDP's parameters.
+
+        Raises:
+            TypeError: `field` is neither.
+        """
+        if isinstance(field, Terrain):
+            field = heightfield_from_terrain(field, config)
+        elif not isinstance(field, Heightfield):
+            raise TypeError(
+                f"LeasEnv(field): expected a Heightfield or a Terrain, got {type(field).__name__}; "
+                "pass load_terrain(path) or heightfield_from_terrain(terrain, config)"
+            )
         self.field = field
         self.config = config
 
@@ -113,15 +130,7 @@ class LeasEnv(Env):
         )
 
     def _zero_metrics(self) -> dict:
-        names = (
-            "direction",
-            "orientation",
-            "effort_orientation",
-            "effort_acceleration",
-            "alive",
-            "clearance",
-        )
-        metrics = {f"reward/{n}": jnp.zeros(()) for n in names}
+        metrics = {f"reward/{n}": v for n, v in reward.zeros().items()}
         metrics.update(invalid=jnp.zeros(()), reached=jnp.zeros(()))
         return metrics
 
@@ -221,13 +230,8 @@ class LeasEnv(Env):
         steps = root.steps + 1
         root = root.replace(pos=pos, vel=vel, yaw=yaw, target_dir=target_dir, steps=steps)
 
-        terms = reward.terms(vel, yaw, action, target_dir, cfg)
+        terms = reward.terms(self.field, root.pose, vel, action, target_dir, cfg)
         ok = reachability.valid(self.field, root.pose, cfg.reachability)
-        terms["clearance"] = (
-            -reachability.clearance_shortfall(self.field, root.pose, cfg.clearance_margin, cfg.reachability)
-            if cfg.rewards.clearance != 0.0
-            else jnp.zeros(())
-        )
         reached = root.follow_point & (
             jnp.linalg.norm(root.target_point - pos[:2]) < cfg.target_reached_distance
         )

@@ -52,8 +52,13 @@ def arena_check(
         {"policy", "terrain", "episodes", "ground": {...}, "arena": {seed: {...}}, "targets", "seconds"}.
     """
     from leas_jax.env import heightfield_from_terrain
-    from leas_jax.eval.geometric import arena_episodes, failure_breakdown, ground_speed
-    from leas_jax.eval.report import ARENA_VALID_TARGET, GROUND_SPEED_TARGET
+    from leas_jax.eval.geometric import (
+        ARENA_VALID_TARGET,
+        GROUND_SPEED_TARGET,
+        arena_episodes,
+        failure_breakdown,
+        ground_speed,
+    )
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
@@ -159,8 +164,8 @@ def failures_figure(terrain, field, episodes, path: Path, seed: int, config) -> 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from leas_jax.eval.figures import draw_heightmap
     from leas_jax.eval.geometric import reachability_terms
+    from leas_jax.plotting import draw_heightmap
 
     figure, axes = plt.subplots(figsize=(9, 9), layout="constrained")
     draw_heightmap(axes, terrain)

@@ -24,6 +24,15 @@ def _positive_int(name: str, allow_zero: bool = False):
     return parse
 
 
+def _checkpoint(args):
+    """--checkpoint as given, or loaded here when --allow-pickle lets a legacy pickle policy in."""
+    if args.checkpoint is None or not args.allow_pickle:
+        return args.checkpoint
+    from leas_jax.training.policy import load_policy
+
+    return load_policy(args.checkpoint, allow_pickle=True)
+
+
 def cmd_evaluate(args) -> int:
     from leas_jax.eval.evaluate import evaluate, parse_methods
     from leas_jax.eval.tables import table_ii_markdown
@@ -49,7 +58,7 @@ def cmd_evaluate(args) -> int:
     report = evaluate(
         scenarios,
         parse_methods(args.methods),
-        args.checkpoint,
+        _checkpoint(args),
         out,
         args.n_starts,
         args.workers,
@@ -83,7 +92,7 @@ def cmd_hole_sweep(args) -> int:
     report = hole_width_sweep(
         parse_widths(args.widths),
         parse_methods(args.methods) or DEFAULT_METHODS,
-        args.checkpoint,
+        _checkpoint(args),
         args.n_starts,
         args.workers,
         out,
@@ -103,7 +112,7 @@ def cmd_arena_check(args) -> int:
     if args.terrain is not None and not Path(args.terrain).is_file():
         raise UsageError(f"--terrain: no such file {args.terrain!r}")
     report = arena_check(
-        args.checkpoint, args.episodes, parse_seeds(args.seeds), terrain_file=args.terrain, out=out
+        _checkpoint(args), args.episodes, parse_seeds(args.seeds), terrain_file=args.terrain, out=out
     )
     print(markdown(report), end="")
     print(f"{report['seconds']:.1f} s -> {out}/arena_check.json, arena_check.md, arena_failures.png")
@@ -111,16 +120,19 @@ def cmd_arena_check(args) -> int:
 
 
 def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_more: str = "") -> None:
-    """--methods, --checkpoint, --n-starts, --workers, --no-progress and --out of the commands that run
-    scenarios."""
+    """--methods, --checkpoint, --allow-pickle, --n-starts, --workers, --no-progress and --out of the
+    commands that run scenarios."""
+    from leas_jax.arguments import add_allow_pickle_argument
+
     parser.add_argument(
         "--methods",
         metavar="LIST",
         help=f"comma-separated subset of {','.join(METHODS)} (default: {methods_default})",
     )
     parser.add_argument(
-        "--checkpoint", metavar="DIR", help="run directory or policy.pkl (for leas, leas_rrt)"
+        "--checkpoint", metavar="DIR", help="run directory or policy.ckpt (for leas, leas_rrt)"
     )
+    add_allow_pickle_argument(parser, "a policy")
     parser.add_argument(
         "--n-starts",
         type=_positive_int("--n-starts"),
@@ -140,7 +152,7 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
 
 
 def register(subparsers) -> None:
-    from leas_jax.cli import add_ray_address_argument
+    from leas_jax.arguments import add_ray_address_argument
 
     parser = subparsers.add_parser(
         "evaluate",
@@ -190,6 +202,8 @@ def register(subparsers) -> None:
     _add_run_arguments(sweep, ",".join(DEFAULT_METHODS), "width")
     sweep.set_defaults(func=cmd_hole_sweep)
 
+    from leas_jax.arguments import add_allow_pickle_argument
+
     check = subparsers.add_parser(
         "arena-check",
         help="speed on eval_ground, safety on the training arena, and why episodes end invalid",
@@ -199,7 +213,8 @@ def register(subparsers) -> None:
         "lies around the root and the speed at the failure. Writes arena_check.json, arena_check.md and "
         "arena_failures.png.",
     )
-    check.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
+    check.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.ckpt")
+    add_allow_pickle_argument(check, "a policy")
     check.add_argument(
         "--episodes",
         type=_positive_int("--episodes"),

@@ -7,8 +7,10 @@ the RRT's validity checks are jitted JAX):
 2. build one guide per start and method: RBLin, RBKino (through the
    waypoints on the circuit), RBKino+RRT (one RRT per start, shared by
    `rbkino_rrt` and `leas_rrt`), LeaS to the target (or along the waypoints),
-   LeaS along the RRT's waypoints;
-3. validate every guide with the contact generator in one worker pool per
+   LeaS along the RRT's waypoints; navigate (`leas_jax.navigate`: the lattice
+   search's waypoints for LeaS, validated and replanned in its own closed loop,
+   so its trajectories arrive with their outcome);
+3. validate every other guide with the contact generator in one worker pool per
    terrain, with a progress bar;
 4. compute coverage and success per trajectory (`metrics`) and aggregate.
 
@@ -58,8 +60,10 @@ class Trajectory:
         speed: initial speed (m/s).
         yaw_offset_deg: start yaw minus the direction to the first target (deg).
         guide: [T, 4] world, or None when the method produced none.
-        waypoints: [W, 2] waypoints the method followed (RRT, circuit), or None.
+        waypoints: [W, 2] waypoints the method followed (RRT, circuit, navigate), or None.
         outcome: `metrics.Outcome` once validated.
+        error: why the method produced no guide, or None.
+        replans: navigate's searches after the first (None for the other methods).
     """
 
     cell: int
@@ -71,6 +75,7 @@ class Trajectory:
     waypoints: np.ndarray | None = None
     outcome: metrics.Outcome | None = None
     error: str | None = None
+    replans: int | None = None  # navigate: searches after the first
 
 
 @dataclass
@@ -201,6 +206,40 @@ def _leas_guides(
     return [result.guide(n).astype(np.float64) for n in range(len(starts.poses))]
 
 
+def _navigate_trajectories(
+    policy, terrain, starts: Starts, points: np.ndarray, workers: int, address, progress: bool
+) -> tuple[list, dict]:
+    """Navigate from every start through the route `points` (closed loop, its own pool).
+
+    Returns:
+        ([(guide or None, waypoints, outcome)] per start, seconds per navigate part summed).
+    """
+    from tqdm.auto import tqdm
+
+    from leas_jax.navigate.loop import Navigator
+
+    navigator = Navigator(policy, terrain)
+    queries = [
+        navigator.query(pose, points[-1], float(speed), points[:-1])
+        for pose, speed in zip(starts.poses, starts.speeds)
+    ]
+    with tqdm(total=len(queries), desc="navigate", disable=not progress, leave=False) as bar:
+        answers = navigator.run(queries, workers=workers, address=address, done=lambda k, r: bar.update(1))
+    out, seconds = [], {"navigate_lattice": navigator.lattice_seconds}
+    for answer in answers:
+        for part in ("search", "rollout", "contact_planning"):
+            seconds[f"navigate_{part}"] = seconds.get(f"navigate_{part}", 0.0) + answer.seconds[part]
+        if answer.plan is None:
+            outcome = metrics.outcome(None, points[-1], 0.0, -1, error=f"navigate: {answer.message}")
+        else:
+            plan = answer.plan
+            outcome = metrics.outcome(
+                answer.guide, points[-1], plan.coverage, plan.last_valid_index, plan=plan
+            )
+        out.append((answer.guide, answer.waypoints, outcome, answer.replans))
+    return out, seconds
+
+
 def build_trajectories(
     name: str,
     terrain,
@@ -215,11 +254,14 @@ def build_trajectories(
     env=None,
     rrt_workers: int = 0,
     leas_stop_at_invalid: bool = False,
+    address: str | None = None,
 ) -> tuple[list[Trajectory], dict]:
-    """Starts and guides of every cell and method of one scenario (no validation yet).
+    """Starts and guides of every cell and method of one scenario (no validation yet, except
+    navigate's: its closed loop validates, its trajectories come with their outcome).
 
     `env` (default: the policy's, else EnvConfig()) is what `field` was built with;
-    `rrt_workers` processes run the RRT searches (0: in this process);
+    `rrt_workers` processes run the RRT searches and navigate's contact generator (0: in
+    this process; `address`: navigate's generator on that Ray cluster);
     `leas_stop_at_invalid`: LeaS paths end before the first pose the reachability
     condition rejects (see `rollout_batch`; default: they roll on, see `evaluate`).
 
@@ -311,6 +353,29 @@ def build_trajectories(
                 [None if p.success else "rrt: no path" for p in plans],
             )
             seconds["leas_rrt"] += time.perf_counter() - began
+        if "navigate" in methods:
+            began = time.perf_counter()
+            answers, parts = _navigate_trajectories(
+                policy, terrain, starts, points, rrt_workers, address, progress
+            )
+            for n, (guide, waypoints, outcome, replans) in enumerate(answers):
+                trajectories.append(
+                    Trajectory(
+                        cell=k,
+                        method="navigate",
+                        start=starts.poses[n],
+                        speed=float(starts.speeds[n]),
+                        yaw_offset_deg=float(starts.yaw_offsets_deg[n]),
+                        guide=guide,
+                        waypoints=waypoints,
+                        outcome=outcome,
+                        error=outcome.error,
+                        replans=replans,
+                    )
+                )
+            seconds["navigate"] += time.perf_counter() - began
+            for part, value in parts.items():
+                seconds[part] = seconds.get(part, 0.0) + value
     order = {m: i for i, m in enumerate(methods)}
     trajectories.sort(key=lambda t: (t.cell, order[t.method]))
     return trajectories, seconds
@@ -325,7 +390,8 @@ def validate(
     desc: str = "contact planning",
     address: str | None = None,
 ) -> None:
-    """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`. Host-only.
+    """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`
+    (trajectories that arrive with one, navigate's, are left as they are). Host-only.
 
     `address`: a Ray cluster for the pool (`ValidationPool(address=...)`); None for local processes.
     """
@@ -334,6 +400,7 @@ def validate(
     from leas_jax.contacts.validation.pool import ValidationPool
 
     target = np.asarray(terrain.scenario.target, np.float64)
+    trajectories = [t for t in trajectories if t.outcome is None]
     todo = [t for t in trajectories if t.guide is not None and t.error is None]
     for t in trajectories:
         if t.guide is None or t.error is not None:
@@ -358,12 +425,12 @@ def validate(
 
 
 def policy_for(methods, checkpoint):
-    """The `Policy` of `checkpoint` when `methods` include leas or leas_rrt, else None;
+    """The `Policy` of `checkpoint` when `methods` include leas, leas_rrt or navigate, else None;
     UsageError naming --checkpoint when they do and it is None."""
     if not any(m in LEAS_METHODS for m in methods):
         return None
     if checkpoint is None:
-        raise UsageError("--checkpoint is required by the methods leas and leas_rrt")
+        raise UsageError("--checkpoint is required by the methods leas, leas_rrt and navigate")
     from leas_jax.training.policy import load_policy
 
     return load_policy(checkpoint)
@@ -432,6 +499,7 @@ def run_scenario(
         env,
         rrt_workers=workers or 0,
         leas_stop_at_invalid=leas_stop_at_invalid,
+        address=address,
     )
     began = time.perf_counter()
     validate(

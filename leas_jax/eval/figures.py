@@ -14,33 +14,11 @@ from pathlib import Path
 import numpy as np
 
 from leas_jax.eval.tables import METHOD_LABELS
+from leas_jax.plotting import draw_heightmap
 
 SUCCESS_COLOR = "tab:blue"
 FAILURE_COLOR = "gold"
 FAILED_PART_COLOR = "red"
-
-
-def draw_heightmap(axes, terrain) -> None:
-    """Top-down heightmap of a terrain into `axes` (void points dark grey)."""
-    import matplotlib.pyplot as plt
-
-    heights = np.asarray(terrain.raster(), np.float64)
-    (xmin, ymin), (xmax, ymax) = terrain.bounds
-    half = terrain.resolution / 2
-    shown = np.ma.masked_where(heights <= terrain.void_height, heights)
-    cmap = plt.get_cmap("Greys").with_extremes(bad="#303030")
-    axes.imshow(
-        shown.T,
-        origin="lower",
-        extent=(xmin - half, xmax + half, ymin - half, ymax + half),
-        cmap=cmap,
-        vmin=float(shown.min()) - 0.3,
-        vmax=float(shown.max()) + 1.0,
-        interpolation="nearest",
-    )
-    axes.set_xlim(xmin, xmax)
-    axes.set_ylim(ymin, ymax)
-    axes.set_aspect("equal")
 
 
 def draw_trajectories(axes, terrain, trajectories, title: str = "") -> None:
@@ -54,7 +32,7 @@ def draw_trajectories(axes, terrain, trajectories, title: str = "") -> None:
             axes.plot(t.guide[: last + 1, 0], t.guide[: last + 1, 1], "-", color=SUCCESS_COLOR, linewidth=0.8)
             if last < len(t.guide) - 1:
                 axes.plot(t.guide[last:, 0], t.guide[last:, 1], "-", color=FAILED_PART_COLOR, linewidth=0.8)
-        if t.waypoints is not None and t.method in ("rbkino_rrt", "leas_rrt"):
+        if t.waypoints is not None and t.method in ("rbkino_rrt", "leas_rrt", "navigate"):
             w = np.asarray(t.waypoints)
             axes.plot(w[:, 0], w[:, 1], ".", color="black", markersize=3)
         color = SUCCESS_COLOR if (o is not None and o.success) else FAILURE_COLOR

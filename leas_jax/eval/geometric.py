@@ -20,6 +20,10 @@ from leas_jax.env import LeasEnv, reachability
 from leas_jax.env.field import Heightfield, sample_nearest
 from leas_jax.steering.leas import rollout_batch, start_poses
 
+# Acceptance figures of a geometric policy (the run report and `leas arena-check` test them):
+GROUND_SPEED_TARGET = 0.12  # m/s, mean ground speed on flat ground
+ARENA_VALID_TARGET = 0.90  # fraction of arena episodes without an invalid pose
+
 
 @dataclass(frozen=True)
 class GroundSpeed:

@@ -9,9 +9,6 @@ import numpy as np
 
 from leas_jax.training.checkpoint import atomic_write_text
 
-GROUND_SPEED_TARGET = 0.12  # m/s, foundation issue acceptance figure
-ARENA_VALID_TARGET = 0.90  # fraction of arena episodes without an invalid pose
-
 
 def read_metrics(run_dir: Path) -> list[dict]:
     """Records of metrics.jsonl (empty list if none)."""
@@ -64,8 +61,14 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     """Markdown lines and figures of a geometric run: learning curves, speed and safety, rollouts."""
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.eval.arena_check import failures_line
-    from leas_jax.eval.geometric import arena_episodes, failure_breakdown, ground_speed
-    from leas_jax.steering.commands import plot_paths
+    from leas_jax.eval.geometric import (
+        ARENA_VALID_TARGET,
+        GROUND_SPEED_TARGET,
+        arena_episodes,
+        failure_breakdown,
+        ground_speed,
+    )
+    from leas_jax.plotting import plot_paths
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy

@@ -17,8 +17,8 @@ import numpy as np
 from leas_jax.errors import UsageError
 
 SCENARIOS = ("ground", "hole", "bridge", "stairs", "stairs_side", "circuit")
-METHODS = ("rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt")
-LEAS_METHODS = ("leas", "leas_rrt")
+METHODS = ("rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt", "navigate")
+LEAS_METHODS = ("leas", "leas_rrt", "navigate")
 RRT_METHODS = ("rbkino_rrt", "leas_rrt")
 
 # Methods the paper runs on each scenario (§IV-B, §IV-C, §IV-D).
@@ -126,7 +126,8 @@ def draw_starts(
     """Seeded starts of one cell: uniform in the start region, yaw offset and speed ranges.
 
     Starts failing the reachability condition (or standing over the void) are
-    drawn again, so that every method starts from a valid pose.
+    drawn again, so that every method starts from a valid pose. A target where
+    the robot cannot stand is an error (`check_target`).
 
     Args:
         scenario: the terrain's `Scenario` (start_region, target, waypoints).
@@ -139,11 +140,15 @@ def draw_starts(
 
     Returns:
         `Starts`.
+
+    Raises:
+        UsageError: a target the robot cannot stand at, or no valid start in the region.
     """
     from leas_jax.env.config import ReachabilityConfig
     from leas_jax.steering.baselines import lift_checked
 
     reach = reachability or ReachabilityConfig()
+    check_target(scenario, field, nominal_root_height, reach)
     rng = np.random.default_rng(seed)
     region = np.asarray(scenario.start_region, np.float64)
     aim = route(scenario)[0]
@@ -166,6 +171,31 @@ def draw_starts(
         speeds.append(speed)
         offsets.append(offset)
     return Starts(np.array(poses).reshape(-1, 4), np.array(speeds), np.array(offsets))
+
+
+# Yaws tried at the target: it is valid ground when the root fits there at one of them.
+_TARGET_YAWS = 16
+
+
+def check_target(scenario, field, nominal_root_height: float, reachability) -> None:
+    """UsageError unless the root fits at the scenario's target at some yaw (reachability condition,
+    solid ground under it): a target inside a wall, a pillar or over the void cannot be reached.
+
+    Args:
+        scenario: the terrain's `Scenario`.
+        field: its heightfield; nominal_root_height: m; reachability: `ReachabilityConfig`.
+    """
+    from leas_jax.steering.baselines import lift_checked
+
+    x, y = (float(v) for v in scenario.target)
+    yaws = np.linspace(-math.pi, math.pi, _TARGET_YAWS, endpoint=False)
+    planar = np.stack([np.full(_TARGET_YAWS, x), np.full(_TARGET_YAWS, y), yaws], axis=1)
+    _, ok = lift_checked(field, planar, nominal_root_height, reachability)
+    if not np.any(ok):
+        raise UsageError(
+            f"scenario.target ({x:g}, {y:g}): the robot cannot stand there at any yaw (inside an "
+            "obstacle, against a wall or over the void: the reachability condition fails)"
+        )
 
 
 # LeaS horizon / time to walk the route at the target speed. The horizon bounds how long

@@ -24,6 +24,7 @@ METHOD_LABELS = {
     "rbkino_rrt": "RBKino+RRT",
     "leas": "LeaS",
     "leas_rrt": "LeaS+RRT waypoints",
+    "navigate": "Navigate (lattice search, LeaS, replans)",
 }
 
 
@@ -99,6 +100,8 @@ def results_dict(results, policy=None, seconds: float = 0.0, leas_stop_at_invali
                     "waypoints": None if t.waypoints is None else np.round(t.waypoints, 6).tolist(),
                 }
             )
+            if t.replans is not None:
+                trajectories[-1]["replans"] = int(t.replans)
         report["scenarios"][result.name] = {
             "terrain": result.terrain.path or result.terrain.name,
             "target": np.asarray(scenario.target).tolist(),

@@ -46,6 +46,12 @@ class BaselineConfig:
     # in rbkino.py.
     v_max: float = 0.18
     a_max: float = 0.10  # m/s^2, per-axis acceleration bound, HPP Talos scripts (aMax)
+    # How RBKino slows its faster axes (`rbkino.steer`): "hpp", hpp-core's
+    # Kinodynamic::fixedTimeTrajectory (a start velocity across the goal direction decays
+    # over the whole path), or "cruise", +-a_max with a lower cruise velocity (that
+    # velocity dies within ~0.1 s, turning the velocity-following yaw by up to 90 degrees
+    # in one step). The RRT (rrt.py) keeps "cruise" (see rbkino.py).
+    rbkino_sync: str = "hpp"
     rotation_steps: int = 100  # RBLin's in-place rotation, paper §IV-B.1 ("here 100 steps")
     nominal_root_height: float = 1.0  # m above the terrain, EnvConfig.nominal_root_height
 

@@ -27,6 +27,32 @@ def _floats(count: int, name: str):
     return parse
 
 
+# Longest horizon `leas rollout` accepts: 20 000 steps is 2 000 s (over half an hour of walking at
+# the paper's 0.1 s step), far past any scenario's route, and keeps the guide, its plan and
+# `leas show`'s page within memory (`leas plan` refuses longer guides, MAX_GUIDE_POSES).
+MAX_ROLLOUT_STEPS = 20_000
+
+
+def _horizon(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer number of steps, got {text!r}") from None
+    if not 1 <= value <= MAX_ROLLOUT_STEPS:
+        raise argparse.ArgumentTypeError(f"expected 1 to {MAX_ROLLOUT_STEPS} steps, got {text!r}")
+    return value
+
+
+def _finite(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not np.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
 def save_guide(path: Path, guide: np.ndarray, timestep: float, terrain_text: str, target) -> None:
     """Write a guide file (docs/design.md §6): guide [T, 4], timestep, terrain text, target [2]; atomic."""
     import io
@@ -44,44 +70,8 @@ def save_guide(path: Path, guide: np.ndarray, timestep: float, terrain_text: str
     atomic_write_bytes(path, buffer.getvalue())
 
 
-def plot_paths(terrain, paths, path: Path, title: str = "", colors=None, target=None) -> None:
-    """Top-down PNG of guide paths over the terrain heightmap.
-
-    Args:
-        terrain: the terrain (drawn with its scenario).
-        paths: list of [T, 4] guides, world.
-        path: PNG file.
-        colors: one matplotlib colour per path (default blue).
-        target: optional (x, y) drawn as a star.
-    """
-    import matplotlib.pyplot as plt
-
-    from leas_jax.terrain.commands import draw_terrain
-
-    figure = draw_terrain(terrain)
-    axes = figure.axes[0]
-    for k, guide in enumerate(paths):
-        color = colors[k] if colors is not None else "tab:blue"
-        axes.plot(guide[:, 0], guide[:, 1], "-", color=color, linewidth=1.2)
-        axes.plot(guide[0, 0], guide[0, 1], "o", color=color, markersize=4)
-        axes.arrow(
-            guide[0, 0],
-            guide[0, 1],
-            0.3 * np.cos(guide[0, 3]),
-            0.3 * np.sin(guide[0, 3]),
-            width=0.02,
-            color="black",
-        )
-    if target is not None:
-        axes.plot(*target, "*", color="red", markersize=14, markeredgecolor="black")
-    if title:
-        axes.set_title(title)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-
-
 def cmd_rollout(args) -> int:
+    from leas_jax.plotting import plot_paths
     from leas_jax.steering.leas import rollout
     from leas_jax.terrain import load_terrain
     from leas_jax.training.policy import load_policy
@@ -89,7 +79,10 @@ def cmd_rollout(args) -> int:
     out = Path(args.out)
     if out.suffix != ".npz":
         raise UsageError(f"--out must end in .npz, got {args.out!r}")
-    policy = load_policy(args.checkpoint)
+    policy = load_policy(args.checkpoint, allow_pickle=args.allow_pickle)
+    v_max = policy.config.env.v_max
+    if not 0.0 <= args.speed <= v_max:
+        raise UsageError(f"--speed {args.speed:g}: expected a speed in [0, {v_max:g}] m/s (the env's v_max)")
     terrain = load_terrain(args.terrain)
     x, y, yaw = args.start
     (xmin, ymin), (xmax, ymax) = terrain.bounds
@@ -124,13 +117,16 @@ def cmd_rollout(args) -> int:
 
 
 def register(subparsers) -> None:
+    from leas_jax.arguments import add_allow_pickle_argument
+
     parser = subparsers.add_parser(
         "rollout",
         help="guide path of a trained policy",
         description="Roll a trained LeaS policy from a start to a target; write the "
         "guide file (.npz, docs/design.md §6) and a top-down PNG beside it.",
     )
-    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
+    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.ckpt")
+    add_allow_pickle_argument(parser, "a policy")
     parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain TOML file")
     parser.add_argument(
         "--start",
@@ -142,8 +138,15 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--target", required=True, type=_floats(2, "--target"), metavar="X,Y", help="target (m)"
     )
-    parser.add_argument("--speed", type=float, default=0.0, help="initial speed along the heading (m/s)")
-    parser.add_argument("--max-steps", type=int, default=None, help="horizon (default 400)")
+    parser.add_argument(
+        "--speed", type=_finite, default=0.0, help="initial speed along the heading (m/s, in [0, v_max])"
+    )
+    parser.add_argument(
+        "--max-steps",
+        type=_horizon,
+        default=None,
+        help=f"horizon in steps, 1 to {MAX_ROLLOUT_STEPS} (default: the policy's episode length, 400)",
+    )
     parser.add_argument("--degrees", action="store_true", help="YAW of --start is in degrees")
     parser.add_argument("--out", required=True, metavar="PATH.npz", help="guide file; the PNG goes beside it")
     parser.add_argument("--plan", metavar="PLAN.npz", help="also run the contact generator and save its plan")

@@ -2,29 +2,44 @@
 
 "Kinodynamic randomized planning for humanoid robots using the reachability
 condition" connects two states (position, velocity) of the root with, on each
-axis, a double integrator under per-axis bounds |v| <= v_max, |a| <= a_max:
+axis, a double integrator under per-axis bounds |v| <= v_max, |a| <= a_max.
+This follows hpp-core's `steeringMethod::Kinodynamic` (src/steering-method/
+steering-kinodynamic.cc) and `KinodynamicOrientedPath` (src/kinodynamic-
+oriented-path.cc):
 
-1. for every axis, the minimum-time bang-bang trajectory (accelerate at
-   +-a_max, coast at +-v_max if the bound is hit, decelerate at -+a_max);
-2. the duration T of the slowest axis is kept; every other axis is slowed
-   down to last exactly T (synchronisation), so all axes arrive together;
-3. the root yaw follows the direction of the horizontal velocity (held while
-   the robot is still).
+1. for every axis, the minimum-time trajectory (`computeMinTime`): accelerate
+   at +-a_max, coast at +-v_max if the bound is hit, decelerate at -+a_max;
+2. the duration T of the slowest axis is kept; every other axis is slowed down
+   to last exactly T (`fixedTimeTrajectory`): a two-segment profile whose
+   acceleration +-a (|a| <= a_max) is the larger root of eq. (20)
+       T^2 a^2 + (2 T (v0 + v1) - 4 d) a - (v1 - v0)^2 = 0,
+   or, when that profile would exceed v_max, three segments that coast at
+   +-v_max with the acceleration that covers d in T. A slowed axis therefore
+   changes its velocity gently over the whole duration: a start velocity
+   across the goal direction decays over the path instead of within 0.1 s;
+3. the root yaw is the direction of the horizontal velocity
+   (`Kinodynamic/forceYawOrientation`, set by every Talos scenario of
+   hpp-rbprm-corba), held while the robot is still.
 
-Synchronisation here keeps the accelerations at +-a_max and lowers the cruise
-velocity vc of a three-phase profile (ramp v0 -> vc, coast at vc, ramp vc ->
-v1): its length D(vc) is non-decreasing in vc (dD/dvc = coast time >= 0), so
-a bisection finds the vc covering the distance in time T. With non-zero end
-velocities some durations longer than an axis's minimum time have no profile
-at all (HPP's "infeasible intervals": e.g. v0 = v1 = 0.1 m/s and 5 cm to go
-in 2 s, every bounded trajectory overshoots); the synchronised duration is
-then the smallest T >= the slowest minimum time at which every axis is
-feasible, found by stepping T up and bisecting.
+With non-zero end velocities some durations longer than an axis's minimum
+time have no bounded trajectory at all (HPP's "infeasible intervals", e.g.
+v0 = v1 = 0.1 m/s and 5 cm to go in 2 s); the synchronised duration is then
+the smallest T >= the slowest minimum time at which every axis is feasible,
+found by stepping T up and bisecting (exact where HPP's `computeMaxRequiredTime`
+uses the intervals of the bang-bang family). The kinodynamic RRT (`rrt.py`)
+keeps the former synchronisation, +-a_max with a lower cruise velocity
+(`steer(..., sync="cruise")`): with HPP's, its search no longer crosses
+tests/test_steering_rrt.py's 0.30 m beam at seed 0 within that test's 3000
+iterations (HPP's curved local paths stay on a narrow beam less often).
 
 Decisions (document, not paper): the path starts with the initial velocity
-along the start heading and ends at rest at the goal; it works on x and y
-(z follows the terrain, as for the other methods); v_max defaults to the
-target speed 0.18 m/s (`BaselineConfig`).
+along the start heading (paper §IV-B: "the initial velocity direction of the
+robot is the same as its orientation"; HPP's `orienteInitAndGoal` turns the
+start configuration to its velocity) and ends at rest at the goal, where the
+last heading is held (HPP turns to the goal configuration's orientation; our
+goal is a point); it works on x and y (z follows the terrain, as for the other
+methods; HPP's Talos scripts bound the vertical velocity to 0); v_max defaults
+to the target speed 0.18 m/s (`BaselineConfig`).
 """
 
 from __future__ import annotations
@@ -38,6 +53,8 @@ from leas_jax.env.field import Heightfield
 from leas_jax.steering.baselines import BaselineConfig, heading_from_velocity, lift
 
 _BISECTION_STEPS = 80  # halvings of the cruise-velocity interval: far below float64 resolution
+# Synchronisations of the faster axes: HPP's fixed-time profile, or +-a_max with a lower cruise velocity.
+SYNCS = ("hpp", "cruise")
 
 
 def min_time(p0, p1, v0, v1, v_max: float, a_max: float) -> np.ndarray:
@@ -125,6 +142,69 @@ def _cruise_velocity(duration, d, v0, v1, v_max, a_max) -> np.ndarray:
     return 0.5 * (lo + hi)
 
 
+def _phase_end(v0, t1, tc, t2, a1, vc):
+    """Distance and end velocity of the profile a1 for t1, coast at vc for tc, -a1 for t2. [A]."""
+    distance = v0 * t1 + 0.5 * a1 * t1**2 + vc * tc + vc * t2 - 0.5 * a1 * t2**2
+    return distance, vc - a1 * t2
+
+
+def fixed_time_profile(duration, d, v0, v1, v_max: float, a_max: float, tol: float = 1e-7):
+    """HPP's fixed-duration profile of each axis (`Kinodynamic::fixedTimeTrajectory`).
+
+    Two segments, +a for t1 then -a for t2 = T - t1, reach (d, v1) when
+        t1 = ((v1 - v0) / a + T) / 2   and   T^2 a^2 + (2 T (v0 + v1) - 4 d) a - (v1 - v0)^2 = 0
+    (eq. 20 of Fernbach et al. 2017); the root of larger |a| is kept. If the peak
+    velocity v0 + a t1 exceeds v_max, three segments coast at vL = sign(a) v_max:
+        t1 = (vL - v0) / a,  t2 = (vL - v1) / a,  a = ((vL - v0)^2 + (vL - v1)^2) / (2 (vL T - d)).
+    An axis with a = 0 (d = v0 T, v1 = v0) moves at constant velocity.
+
+    Args:
+        duration: T (s).
+        d, v0, v1: [A] displacement (m), start and end velocity (m/s).
+        v_max, a_max: bounds.
+        tol: m and m/s, end-state error above which an axis has no such profile.
+
+    Returns:
+        (t1, tc, t2, a1, vc, ok): [A] phase times, first acceleration (the last
+        one is -a1), coast velocity (the peak of a two-segment profile) and
+        whether the profile is valid (phases >= 0, bounds kept, end state reached).
+    """
+    T = float(duration)
+    d, v0, v1 = (np.asarray(a, np.float64) for a in (d, v0, v1))
+    b = 2.0 * T * (v0 + v1) - 4.0 * d
+    c = -((v1 - v0) ** 2)
+    # Stable roots of T^2 a^2 + b a + c: q / T^2 and c / q (their product c / T^2 <= 0).
+    q = -0.5 * (b + np.where(b >= 0, 1.0, -1.0) * np.sqrt(b * b - 4.0 * T * T * c))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x1 = q / (T * T)
+        x2 = np.where(q != 0, c / q, 0.0)
+    a = np.clip(np.where(np.abs(x1) >= np.abs(x2), x1, x2), -a_max, a_max)
+    still = np.abs(a) < 1e-15
+    safe_a = np.where(still, 1.0, a)
+    t1 = np.where(still, 0.0, 0.5 * ((v1 - v0) / safe_a + T))
+    peak = v0 + a * t1
+    coast = np.abs(peak) > v_max
+    # Three segments where the peak exceeds v_max.
+    v_lim = np.where(a >= 0, v_max, -v_max)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a3 = ((v_lim - v0) ** 2 + (v_lim - v1) ** 2) / (2.0 * (v_lim * T - d))
+    a3 = np.clip(np.where(np.isfinite(a3), a3, 0.0), -a_max, a_max)
+    safe_a3 = np.where(np.abs(a3) < 1e-15, 1.0, a3)
+    t1 = np.where(coast, (v_lim - v0) / safe_a3, t1)
+    t2 = np.where(coast, (v_lim - v1) / safe_a3, np.where(still, 0.0, T - t1))
+    tc = np.where(coast, T - t1 - t2, np.where(still, T, 0.0))
+    a1 = np.where(coast, a3, np.where(still, 0.0, a))
+    vc = np.where(coast, v_lim, np.where(still, v0, peak))
+    distance, end_velocity = _phase_end(v0, t1, tc, t2, a1, vc)
+    ok = (
+        (np.minimum(np.minimum(t1, tc), t2) >= -1e-9)
+        & (np.abs(vc) <= v_max + 1e-9)
+        & (np.abs(distance - d) <= tol)
+        & (np.abs(end_velocity - v1) <= tol)
+    )
+    return np.maximum(t1, 0.0), np.maximum(tc, 0.0), np.maximum(t2, 0.0), a1, vc, ok
+
+
 @dataclass(frozen=True)
 class KinoProfile:
     """Synchronised per-axis three-phase profiles, all of the same duration.
@@ -178,14 +258,20 @@ class KinoProfile:
         return pos, vel
 
 
-def steer(p0, v0, p1, v1, v_max: float, a_max: float, duration: float | None = None) -> KinoProfile:
-    """RBKino between two states: per-axis bang-bang, synchronised to the slowest axis.
+def steer(
+    p0, v0, p1, v1, v_max: float, a_max: float, duration: float | None = None, sync: str = "cruise"
+) -> KinoProfile:
+    """RBKino between two states: the slowest axis's minimum time, every axis lasting it.
 
     Args:
         p0, v0: [A] start position (m) and velocity (m/s).
         p1, v1: [A] end position and velocity.
         v_max, a_max: per-axis bounds.
         duration: force a duration (s) >= the minimum; default the slowest axis's minimum time.
+        sync: how the faster axes are slowed to the duration: "hpp", HPP's fixed-time profile
+            (`fixed_time_profile`, what `rbkino` uses by default: `BaselineConfig.rbkino_sync`);
+            "cruise", +-a_max with a lower cruise velocity (bisection on the monotone length),
+            which the RRT (`rrt.py`) calls with.
 
     Returns:
         the `KinoProfile`.
@@ -202,11 +288,21 @@ def steer(p0, v0, p1, v1, v_max: float, a_max: float, duration: float | None = N
         raise ValueError(f"rbkino: duration {T} below the minimum time {float(np.max(fastest))}")
     if duration is None and not _feasible(T, p1 - p0, v0, v1, v_max, a_max):
         T = _first_feasible(T, p1 - p0, v0, v1, v_max, a_max)
-    vc = _cruise_velocity(T, p1 - p0, v0, v1, v_max, a_max)
-    t1, tc, t2, _ = _three_phase(vc, v0, v1, T, a_max)
-    tc = np.maximum(tc, 0.0)
-    a1 = np.sign(vc - v0) * a_max
-    a2 = np.sign(v1 - vc) * a_max
+    if sync not in SYNCS:
+        raise ValueError(f"rbkino: sync {sync!r} is not one of {SYNCS}")
+    if sync == "hpp":
+        t1, tc, t2, a1, vc, ok = fixed_time_profile(T, p1 - p0, v0, v1, v_max, a_max)
+        if not np.all(ok):  # never met (8000 random states); an error, not a wrong path
+            raise ValueError(
+                f"rbkino: no fixed-time profile of {T} s from v0={v0} to v1={v1} over {p1 - p0} m"
+            )
+        a2 = -a1
+    else:
+        vc = _cruise_velocity(T, p1 - p0, v0, v1, v_max, a_max)
+        t1, tc, t2, _ = _three_phase(vc, v0, v1, T, a_max)
+        tc = np.maximum(tc, 0.0)
+        a1 = np.sign(vc - v0) * a_max
+        a2 = np.sign(v1 - vc) * a_max
     return KinoProfile(duration=T, p0=p0, v0=v0, v1=v1, t1=t1, tc=tc, t2=t2, a1=a1, a2=a2, vc=vc)
 
 
@@ -229,7 +325,9 @@ def rbkino_states(
     Returns:
         (positions [T, 2], velocities [T, 2]) at t = k dt, the last at the full duration.
     """
-    profile = steer(start_xy, start_velocity, goal_xy, goal_velocity, config.v_max, config.a_max)
+    profile = steer(
+        start_xy, start_velocity, goal_xy, goal_velocity, config.v_max, config.a_max, sync=config.rbkino_sync
+    )
     return profile.state(sample_times(profile.duration, config.timestep))
 
 

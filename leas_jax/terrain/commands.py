@@ -11,12 +11,9 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from leas_jax.errors import UsageError
 from leas_jax.terrain.export import EXPORT_EXTENSIONS
 from leas_jax.terrain.loader import load_terrain
-from leas_jax.terrain.model import Terrain
 
 
 def register(subparsers) -> None:
@@ -89,16 +86,13 @@ def cmd_show(args: argparse.Namespace) -> None:
     out = Path(args.out)
     if out.suffix.lower() != ".png":
         raise UsageError(f"terrain show: --out {args.out}: the image must be a .png file")
-    terrain = load_terrain(args.file)
-    figure = draw_terrain(terrain)
+    from leas_jax.plotting import terrain_figure
+
+    figure = terrain_figure(load_terrain(args.file))
     try:
         figure.savefig(out, dpi=150)
     except OSError as err:
         raise UsageError(f"terrain show: --out {args.out}: cannot write: {err.strerror or err}") from None
-    finally:
-        import matplotlib.pyplot as plt
-
-        plt.close(figure)
     print(f"wrote {out}")
 
 
@@ -113,79 +107,6 @@ def cmd_export(args: argparse.Namespace) -> None:
     terrain = load_terrain(args.file)
     terrain.export(out)
     print(f"wrote {out}")
-
-
-def draw_terrain(terrain: Terrain):
-    """Top-down heightmap figure of a terrain with its scenario, if any.
-
-    Void points are drawn in a separate dark colour so that holes stand out from low
-    ground. Start region: dashed rectangle; target: star; waypoints: numbered dots
-    joined in order.
-
-    Returns:
-        matplotlib Figure (Agg backend; the caller saves and closes it).
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Rectangle
-
-    heights = np.asarray(terrain.raster(), dtype=np.float64)
-    (xmin, ymin), (xmax, ymax) = terrain.bounds
-    half = terrain.resolution / 2
-    extent = (xmin - half, xmax + half, ymin - half, ymax + half)
-    void = heights <= terrain.void_height
-    shown = np.ma.masked_where(void, heights)
-    width = 8.0
-    figure, axes = plt.subplots(
-        figsize=(width, max(3.0, width * (ymax - ymin) / (xmax - xmin))), layout="constrained"
-    )
-    cmap = plt.get_cmap("viridis").with_extremes(bad="#202020")
-    # heights[i, j] is at (x_i, y_j): transpose so that rows are y for imshow.
-    image = axes.imshow(shown.T, origin="lower", extent=extent, cmap=cmap, interpolation="nearest")
-    figure.colorbar(
-        image, ax=axes, label=f"height (m); void (z = {terrain.void_height:g}) in black", shrink=0.9
-    )
-    scenario = terrain.scenario
-    if scenario is not None:
-        (rx0, ry0), (rx1, ry1) = scenario.start_region
-        axes.add_patch(
-            Rectangle(
-                (rx0, ry0),
-                rx1 - rx0,
-                ry1 - ry0,
-                fill=False,
-                edgecolor="red",
-                linestyle="--",
-                linewidth=1.5,
-                label="start region",
-            )
-        )
-        route = [np.mean(scenario.start_region, axis=0)]
-        if scenario.waypoints is not None:
-            route += list(scenario.waypoints)
-            axes.plot(
-                scenario.waypoints[:, 0],
-                scenario.waypoints[:, 1],
-                "o",
-                color="gold",
-                markeredgecolor="black",
-                label="waypoints",
-            )
-            for k, (wx, wy) in enumerate(scenario.waypoints):
-                axes.annotate(str(k + 1), (wx, wy), textcoords="offset points", xytext=(4, 4), fontsize=8)
-        route.append(scenario.target)
-        route = np.array(route)
-        axes.plot(route[:, 0], route[:, 1], ":", color="black", linewidth=1)
-        axes.plot(*scenario.target, "*", color="red", markersize=14, markeredgecolor="black", label="target")
-        axes.legend(loc="upper right", fontsize=8)
-    axes.set_xlabel("x (m)")
-    axes.set_ylabel("y (m)")
-    parts = [f"{len(terrain.boxes)} boxes"] + ([f"{len(terrain.meshes)} meshes"] if terrain.meshes else [])
-    axes.set_title(f"{terrain.name}: {', '.join(parts)}, resolution {terrain.resolution:g} m")
-    axes.set_aspect("equal")
-    return figure
 
 
 def _write(path: Path, text: str) -> None:

@@ -86,6 +86,17 @@ class TerrainMesh:
         """[F, 3, 3] corner positions, world, m."""
         return self.vertices[self.faces]
 
+    def aabb(self) -> np.ndarray:
+        """[2, 3] axis-aligned bounds (min row, max row), world (as `Box.aabb`)."""
+        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+
+    def column_top(self, x, y) -> np.ndarray:
+        """Highest point of this mesh on vertical lines through (x, y) [...] (as `Box.column_top`):
+        [...] z, -inf where the line misses it. Builds a `MeshIndex` of this mesh alone."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64))
+        top = MeshIndex([self]).column_top(np.stack([x.reshape(-1), y.reshape(-1)], axis=1))
+        return top.reshape(x.shape)
+
 
 def _edge_setup(tri: np.ndarray):
     """Per triangle, the planar edge functions of its xy projection.

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from leas_jax.errors import LeasError
+from leas_jax.errors import TerrainError
 from leas_jax.terrain.mesh import MeshIndex, support_polygons
 
 # Boxes are closed sets: a raster point exactly on a box edge belongs to it. Grid
@@ -26,10 +26,6 @@ _CHUNK_POINTS = 1 << 20
 # A face is buried if a point this far above its centre (along its normal) lies
 # inside another box: a step resting on the ground covers the ground face there.
 _BURIED_PROBE = 1e-3  # m
-
-
-class TerrainError(LeasError):
-    """Invalid terrain file or terrain input; the message names file, key and value."""
 
 
 def _frozen_array(value, shape: tuple[int, ...]) -> np.ndarray:

@@ -1,26 +1,21 @@
-"""`leas train` and `leas run`."""
+"""`leas train`, and the training arguments `leas run` shares (leas_jax.pipeline)."""
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 from pathlib import Path
 
+from leas_jax.arguments import (
+    add_allow_pickle_argument,
+    add_ray_address_argument,
+    non_negative_seconds,
+    positive_int,
+)
 from leas_jax.errors import UsageError
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text.replace("_", ""))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
-    return value
-
-
-def _add_training_arguments(parser) -> None:
-    from leas_jax.cli import add_ray_address_argument
+def add_training_arguments(parser) -> None:
+    """The arguments of `leas train`, which `leas run` takes too."""
     from leas_jax.training.config import PRESETS
 
     parser.add_argument(
@@ -65,10 +60,10 @@ def _add_training_arguments(parser) -> None:
         help="training terrain (default terrains/training_arena.toml)",
     )
     parser.add_argument(
-        "--timesteps", type=_positive_int, default=None, help="override the preset's env steps"
+        "--timesteps", type=positive_int, default=None, help="override the preset's env steps"
     )
     parser.add_argument(
-        "--num-envs", type=_positive_int, default=None, help="override the number of parallel envs"
+        "--num-envs", type=positive_int, default=None, help="override the number of parallel envs"
     )
     parser.add_argument(
         "--reachability",
@@ -81,6 +76,15 @@ def _add_training_arguments(parser) -> None:
         "gives the trade)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--checkpoint-every",
+        type=non_negative_seconds,
+        default=None,
+        metavar="SECONDS",
+        help="wall-clock seconds between checkpoints (default 60; 0: after every logged iteration); "
+        "a checkpoint is also written at the end and on Ctrl-C",
+    )
+    add_allow_pickle_argument(parser, "checkpoints (resume, --init)")
 
 
 def config_from_args(args):
@@ -106,6 +110,8 @@ def config_from_args(args):
         overrides["num_timesteps"] = args.timesteps
     if args.num_envs is not None:
         overrides["num_envs"] = args.num_envs
+    if args.checkpoint_every is not None:
+        overrides["checkpoint_every_s"] = args.checkpoint_every
     config = preset(args.preset, mode=args.mode, **overrides)
     if args.reachability == "calibrated":
         from leas_jax.env import ReachabilityConfig
@@ -121,7 +127,12 @@ def cmd_train(args) -> int:
 
     config = config_from_args(args)
     result = train(
-        config, args.out, progress=not args.no_progress, workers=args.workers, address=args.ray_address
+        config,
+        args.out,
+        progress=not args.no_progress,
+        workers=args.workers,
+        address=args.ray_address,
+        allow_pickle=args.allow_pickle,
     )
     metrics = result.metrics
     print(
@@ -131,41 +142,20 @@ def cmd_train(args) -> int:
     return 0
 
 
-def cmd_run(args) -> int:
-    """Geometric training, planner-in-the-loop fine-tuning, evaluation report (each phase resumes)."""
-    from leas_jax.eval.report import write_report
-    from leas_jax.training.config import preset
-    from leas_jax.training.loop import train
+def cmd_convert(args) -> int:
+    """`leas convert`: rewrite a run directory's pickle policy and checkpoints in the checkpoint format."""
+    from leas_jax.training.checkpoint import convert_run
 
-    out = Path(args.out)
-    if args.mode != "geometric" or args.init is not None:
-        raise UsageError("leas run trains both phases itself: drop --mode and --init")
-    geometric = config_from_args(args)
-    train(geometric, out / "geometric", progress=not args.no_progress)
-    if args.planner_steps > 0:
-        overrides = {
-            "num_timesteps": args.planner_steps,
-            "init_from": str(out / "geometric"),
-            "terrain": geometric.terrain,
-            "seed": geometric.seed,
-            "env": geometric.env,
-        }
-        train(
-            preset(args.preset, mode="planner", **overrides),
-            out / "planner",
-            progress=not args.no_progress,
-            workers=args.workers,
-            address=args.ray_address,
+    if not args.allow_pickle:
+        raise UsageError(
+            "convert reads pickle files, which can run code: pass --allow-pickle to confirm you trust them"
         )
-    workers = 2 if args.workers is None else args.workers
-    report = write_report(
-        out,
-        n_episodes=args.eval_episodes,
-        compare_starts=args.compare_starts,
-        baseline_starts=args.baseline_starts,
-        workers=workers,
-    )
-    print(f"report: {report}")
+    for run in args.run_dir:
+        if not Path(run).is_dir():
+            raise UsageError(f"RUN_DIR: {run}: not a directory")
+    for run in args.run_dir:
+        for old, new in convert_run(Path(run)):
+            print(f"{old} -> {new}")
     return 0
 
 
@@ -174,44 +164,20 @@ def register(subparsers) -> None:
         "train",
         help="train a LeaS policy (geometric PPO)",
         description="Train a LeaS policy with Brax PPO on the training arena. "
-        "Writes config.json, checkpoints/, policy.pkl, metrics.jsonl "
+        "Writes config.json, checkpoints/, policy.ckpt, metrics.jsonl "
         "and tb/ into --out; an interrupted run resumes from its last "
         "checkpoint when started again with the same --out.",
     )
-    _add_training_arguments(train)
+    add_training_arguments(train)
     train.set_defaults(func=cmd_train)
 
-    run = subparsers.add_parser(
-        "run",
-        help="the main job: train, fine-tune with the planner, evaluate",
-        description="Geometric training (<out>/geometric), planner-in-the-loop "
-        "fine-tuning (<out>/planner), then <out>/report.md: learning "
-        "curves, rollouts, coverage before/after, Table II against the "
-        "baselines. Each phase resumes if interrupted.",
+    convert = subparsers.add_parser(
+        "convert",
+        help="rewrite pickle policies and checkpoints of earlier versions in the checkpoint format",
+        description="Read RUN_DIR/policy.pkl and RUN_DIR/checkpoints/step_*.pkl (pickles of earlier "
+        "versions, which can run code when loaded) and write policy.ckpt and step_*.ckpt beside them "
+        "(data only, with a checksum); the pickles are kept. Same parameters, bit for bit.",
     )
-    _add_training_arguments(run)
-    run.add_argument(
-        "--eval-episodes",
-        type=_positive_int,
-        default=256,
-        help="episodes per geometric evaluation metric (default 256)",
-    )
-    run.add_argument(
-        "--planner-steps",
-        type=int,
-        default=150_000,
-        help="kept env steps of planner-in-the-loop fine-tuning (default 150 000; 0 skips it; see docs/results for 500 000)",
-    )
-    run.add_argument(
-        "--compare-starts",
-        type=_positive_int,
-        default=24,
-        help="starts per terrain for the before/after coverage comparison (default 24)",
-    )
-    run.add_argument(
-        "--baseline-starts",
-        type=_positive_int,
-        default=10,
-        help="trajectories per Table II cell in the report (default 10; the paper: 60)",
-    )
-    run.set_defaults(func=cmd_run)
+    convert.add_argument("run_dir", nargs="+", metavar="RUN_DIR")
+    add_allow_pickle_argument(convert, "the pickles to convert (required)")
+    convert.set_defaults(func=cmd_convert)

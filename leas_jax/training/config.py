@@ -36,15 +36,14 @@ REPO_ROOT = Path(__file__).resolve().parents[2]
 # r 0.05 m reaching 0.55-1.175 m below the root; no lookahead, foothold or hands term.
 # It is looser than ReachabilityConfig's calibrated default (sensitivity / specificity
 # 78.6 / 89.7 % against the walking generator on 48 000 arena poses, where the default
-# gives 95.7 / 90.0 %). Geometric policies trained with the ninth session's calibrated
-# default (trunk bottom -0.70 m, no foothold term) climb eval_stairs and follow
-# eval_circuit more reliably, but barely step onto eval_bridge's beam (0-11.7 % over four
-# `quick` seeds against 0-43.3 %: its lookahead legs must be on the 0.30 m beam 0.30 m before
-# the root is), a `paper` run with it fell behind the shipped pretrain everywhere but the
-# hole, and their arena episodes end 2-3 times as often, mostly on the hands term, whose
-# disks lie beyond the heightmap's +-0.45 m (so `make run`'s >= 90 % arena target would fail).
-# README, "Contact generator", gives the figures. The planner-in-the-loop phase catches
-# what this looser condition lets through.
+# gives 95.7 / 90.0 %). Geometric policies trained with a calibrated condition climb
+# eval_stairs and follow eval_circuit more reliably, but barely step onto eval_bridge's beam
+# (its lookahead legs must be on the 0.30 m beam 0.30 m before the root is), and their arena
+# episodes end 2-3 times as often, mostly on the hands term, whose disks lie beyond the
+# heightmap's +-0.45 m (so `make run`'s >= 90 % arena target would fail). Figures:
+# docs/results/2026-11-22-benchmarks-h100/condition_comparison.json and docs/results/INDEX.md,
+# "Reachability calibration". The planner-in-the-loop phase catches what this looser
+# condition lets through.
 REACHABILITY_TERMS_OFF = dict(leg_forward=0.0, foothold_spread=None, hand_radius=None)
 TRAINING_REACHABILITY = ReachabilityConfig(trunk_bottom=-0.825, leg_top=-0.55, **REACHABILITY_TERMS_OFF)
 TRAINING_ENV = EnvConfig(reachability=TRAINING_REACHABILITY)
@@ -183,9 +182,10 @@ class TrainConfig:
 # `paper` keeps): minus the fraction of the six root poses shifted by 0.10 m along the root
 # frame's axes that fail the reachability condition. Without it, `quick` policies end 11-17 %
 # of training-arena episodes on an invalid pose, mostly near-misses while creeping beside
-# walls, pillars and stairs (`leas arena-check`); with it, see the README's "Training" section.
-# It stays out of `paper`: on a 0.30 m beam its sideways probes fail 1.5 cm off the axis, and a
-# paper run with it crossed eval_bridge 3.3 % of the time against 68.3 % without (same README).
+# walls, pillars and stairs (`leas arena-check`); with it, 92-94 % stay valid at 0.10 m
+# (docs/results/INDEX.md, "The clearance term"). It stays out of `paper`: on a 0.30 m beam
+# its sideways probes fail 1.5 cm off the axis, and a paper run with it crossed eval_bridge
+# 3.3 % of the time against 68.3 % without (same section).
 QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.0), clearance_margin=0.10)
 
 PRESETS = {
@@ -216,7 +216,7 @@ PRESETS = {
 # `smoke` trains from scratch. The learning rate decays linearly to 0 over the
 # kept steps (Stable Baselines' PPO1 default, as in the geometric presets); a
 # constant 5e-4 made a 500 k-step fine-tuning worse than a 150 k-step one
-# (docs/results/make-run-2026-11-22-planner-500k).
+# (docs/results/2026-11-22-make-run-planner-500k).
 PLANNER_PRESETS = {
     "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
     "quick": dict(

@@ -17,7 +17,7 @@ import jax
 import numpy as np
 
 from leas_jax.errors import LeasError, UsageError
-from leas_jax.training import checkpoint
+from leas_jax.training import checkpoint, records
 from leas_jax.training.config import TrainConfig, pretraining_config, resolve_data_path
 from leas_jax.training.ppo import TrainState, init_state, make_train_call
 
@@ -33,20 +33,86 @@ class TrainResult:
     metrics: dict
 
 
-def _check_config(run_dir: Path, config: TrainConfig) -> None:
-    """Write config.json, or check that a resumed run uses the same config."""
-    path = run_dir / "config.json"
-    if not path.exists():
-        checkpoint.atomic_write_text(path, config.to_json())
-        return
-    saved = json.loads(path.read_text())
+# TrainConfig keys that say how a run is recorded, not what it learns: a resumed run may change them.
+RECORDING_KEYS = ("checkpoint_every_s", "keep_checkpoints")
+
+
+def _config_differences(saved: dict, config: TrainConfig) -> list[str]:
+    """Top-level TrainConfig keys (outside RECORDING_KEYS) whose values differ from `saved`."""
     current = json.loads(config.to_json())
-    diff = sorted(k for k in set(saved) | set(current) if saved.get(k) != current.get(k))
-    if diff:
-        raise UsageError(
-            f"{path}: run directory holds a run with a different config "
-            f"(differs in {', '.join(diff)}); use another --out or the same settings"
-        )
+    saved = json.loads(json.dumps(saved))  # tuples -> lists, as in config.json
+    keys = (set(saved) | set(current)) - set(RECORDING_KEYS)
+    return sorted(k for k in keys if saved.get(k) != current.get(k))
+
+
+def _saved_config(run_dir: Path, from_checkpoint: dict | None) -> dict:
+    """The config a run directory's checkpoint trains: the one stored in the checkpoint, else config.json."""
+    if from_checkpoint is not None:
+        return from_checkpoint
+    path = run_dir / "config.json"
+    try:
+        saved = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise LeasError(
+            f"{path}: cannot read the config of the run to resume ({exc}); "
+            "its checkpoint is of an earlier version that does not store it"
+        ) from None
+    if not isinstance(saved, dict):
+        raise LeasError(f"{path}: not a TrainConfig object")
+    return saved
+
+
+def _check_config(run_dir: Path, config: TrainConfig, saved: dict | None) -> None:
+    """Refuse to resume a run trained with another config; (re)write config.json.
+
+    Args:
+        saved: the resumed run's config, None when nothing is resumed (a run that
+            never checkpointed leaves nothing to protect, so its config.json is replaced).
+    """
+    path = run_dir / "config.json"
+    if saved is not None:
+        diff = _config_differences(saved, config)
+        if diff:
+            raise UsageError(
+                f"{path}: run directory holds a run with a different config "
+                f"(differs in {', '.join(diff)}); use another --out or the same settings"
+            )
+    checkpoint.atomic_write_text(path, config.to_json())
+
+
+def resume_point(run_dir: Path, allow_pickle: bool = False):
+    """(TrainState, config dict or None, path) of the newest intact checkpoint of a run, or None.
+
+    Newer checkpoints that are damaged (truncated, checksum mismatch, malformed)
+    are renamed `<name>.corrupt` with a `CheckpointWarning`, so nothing is lost and
+    the next resume does not meet them again. A refused legacy pickle is an error,
+    not damage; so is a run whose every checkpoint is damaged (nothing is renamed then).
+    """
+    import os
+    import warnings
+
+    found = checkpoint.list_checkpoints(run_dir)
+    damaged = []
+    for _, path in reversed(found):
+        try:
+            state, config = checkpoint.read_state(path, allow_pickle)
+        except checkpoint.PickleRefused:
+            raise
+        except checkpoint.CheckpointError as exc:
+            damaged.append((path, exc))
+            continue
+        for bad, exc in damaged:
+            aside = bad.with_name(bad.name + ".corrupt")
+            os.replace(bad, aside)
+            warnings.warn(
+                f"{exc}; moved it to {aside.name} and resumed from the older {path.name}",
+                checkpoint.CheckpointWarning,
+                stacklevel=2,
+            )
+        return state, config, path
+    if damaged:
+        raise LeasError(f"{run_dir}: no intact checkpoint to resume from; {damaged[0][1]}")
+    return None
 
 
 class RunLog:
@@ -67,8 +133,10 @@ class RunLog:
 
         self.run_dir, self.config, self.on_log = run_dir, config, on_log
         self.path = run_dir / "metrics.jsonl"
-        lines = self.path.read_text().splitlines() if (resumed and self.path.exists()) else []
-        self.wall_before = float(json.loads(lines[-1])["wall_s"]) if lines else 0.0
+        # back to the checkpoint: a resumed run's records equal an uninterrupted run's
+        kept = records.truncate_metrics(self.path, int(state.iteration) if resumed else 0)
+        records.truncate_events(run_dir / "tb", int(state.env_steps) if resumed else -1)
+        self.wall_before = float(kept[-1].get("wall_s", 0.0)) if kept else 0.0
         self.writer = SummaryWriter(str(run_dir / "tb"))
         self.bar = tqdm(
             total=total_steps,
@@ -89,6 +157,7 @@ class RunLog:
         for k, v in record.items():
             if k not in ("iteration", "env_steps"):
                 self.writer.add_scalar(k, v, record["env_steps"])
+        self.writer.flush()  # the event file holds what metrics.jsonl holds, for truncation on resume
         if self.on_log:
             self.on_log(record)
         self.bar.update(new_steps)
@@ -101,7 +170,7 @@ class RunLog:
 
     def checkpoint(self, state: TrainState) -> None:
         steps = int(state.env_steps)
-        checkpoint.save_state(self.run_dir, state, steps, self.config.keep_checkpoints)
+        checkpoint.save_state(self.run_dir, state, steps, self.config.keep_checkpoints, self.config.to_dict())
         checkpoint.save_policy(
             self.run_dir, state.normalizer, state.params.policy, self.config.to_dict(), steps
         )
@@ -130,12 +199,12 @@ def _summarise(raw: dict, env_steps: int, iteration: int, sps: float) -> dict:
     return record
 
 
-def initial_params_from(run_dir: str | Path):
-    """(params, normalizer) of the newest full checkpoint of a run directory (for `init_from`)."""
-    found = checkpoint.list_checkpoints(resolve_data_path(run_dir))
-    if not found:
-        raise LeasError(f"{run_dir}: no checkpoints/step_*.pkl to initialise from")
-    state = checkpoint.load_state(found[-1][1])
+def initial_params_from(run_dir: str | Path, allow_pickle: bool = False):
+    """(params, normalizer) of the newest intact full checkpoint of a run directory (for `init_from`)."""
+    found = resume_point(resolve_data_path(run_dir), allow_pickle)
+    if found is None:
+        raise LeasError(f"{run_dir}: no checkpoints/step_*.ckpt to initialise from")
+    state = found[0]
     return state.params, state.normalizer
 
 
@@ -149,6 +218,7 @@ def train(
     workers: int | None = None,
     address: str | None = None,
     pool_options: dict | None = None,
+    allow_pickle: bool = False,
 ) -> TrainResult:
     """Train a LeaS policy; resume if `out` holds a checkpoint.
 
@@ -169,9 +239,11 @@ def train(
             cluster, see `leas_jax.contacts.validation.pool.register_backend`).
         pool_options: planner mode: more `ValidationPool` keyword arguments
             (task_timeout, max_attempts, plan_fn for fault-injection tests).
+        allow_pickle: also read legacy pickle checkpoints (resume, `init_from`);
+            unpickling can run code, so only for files you trust (warns).
 
     Returns:
-        TrainResult with the run directory and `policy.pkl` path.
+        TrainResult with the run directory and `policy.ckpt` path.
 
     Host function: runs jitted iterations, writes files; not jittable.
     """
@@ -179,31 +251,34 @@ def train(
     from leas_jax.terrain import load_terrain
 
     config.validate()
-    run_dir = Path(out)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    _check_config(run_dir, config)
+    # everything that can fail on bad input is checked before anything is written
     terrain = load_terrain(config.terrain_path())
     if field is None:
         field = heightfield_from_terrain(terrain, config.env)
-    found = checkpoint.list_checkpoints(run_dir)
+    run_dir = Path(out)
+    if run_dir.exists() and not run_dir.is_dir():
+        raise UsageError(f"--out {run_dir}: exists and is not a directory")
+    resumed = resume_point(run_dir, allow_pickle)
+    _check_config(run_dir, config, None if resumed is None else _saved_config(run_dir, resumed[1]))
     init_from = config.init_from
-    if config.mode == "planner" and not init_from and config.pretrain and not found:
+    if config.mode == "planner" and not init_from and config.pretrain and resumed is None:
         init_from = run_dir / "pretrain"
         pretrain = pretraining_config(config)
         saved = checkpoint.list_checkpoints(init_from)
         if not saved or saved[-1][0] < pretrain.num_iterations * pretrain.batch_size:  # else: finished
-            train(pretrain, init_from, progress=progress, field=field)
+            train(pretrain, init_from, progress=progress, field=field, allow_pickle=allow_pickle)
+    initial = initial_params_from(init_from, allow_pickle) if resumed is None and init_from else None
     state: TrainState = init_state(config, field)
-    if found:
-        state = jax.tree.map(jax.numpy.asarray, checkpoint.load_state(found[-1][1]))
-    elif init_from:
-        params, normalizer = initial_params_from(init_from)
+    if resumed is not None:
+        state = jax.tree.map(jax.numpy.asarray, resumed[0])
+    elif initial is not None:
+        params, normalizer = initial
         state = state.replace(
             params=jax.tree.map(jax.numpy.asarray, params),
             normalizer=jax.tree.map(jax.numpy.asarray, normalizer),
         )
     total = config.num_timesteps if config.mode == "planner" else config.num_iterations * config.batch_size
-    log = RunLog(run_dir, config, state, bool(found), progress, total, on_log)
+    log = RunLog(run_dir, config, state, resumed is not None, progress, total, on_log)
     run = _planner_iterations if config.mode == "planner" else _geometric_iterations
     t_start = time.perf_counter()
     try:
@@ -224,7 +299,7 @@ def train(
     log.close()
     return TrainResult(
         run_dir=run_dir,
-        policy_path=run_dir / "policy.pkl",
+        policy_path=run_dir / checkpoint.POLICY_NAME,
         env_steps=int(state.env_steps),
         wall_s=time.perf_counter() - t_start,
         metrics=log.record,

@@ -32,7 +32,13 @@ from leas_jax.env import LeasEnv
 from leas_jax.env.field import Heightfield
 from leas_jax.training.config import TrainConfig
 from leas_jax.training.networks import make_networks
-from leas_jax.training.ppo import TrainState, make_optimizer, planner_learning_rate, with_learning_rate
+from leas_jax.training.ppo import (
+    TrainState,
+    make_optimizer,
+    planner_learning_rate,
+    sgd_epochs,
+    with_learning_rate,
+)
 
 
 @struct.dataclass
@@ -201,23 +207,15 @@ def make_planner_fns(config: TrainConfig):
         # a batch with every step pruned carries no statistics (a zero count would divide by zero)
         normalizer = jax.tree.map(lambda new, old: jnp.where(kept > 0, new, old), updated, state.normalizer)
 
-        def minibatch(carry, inputs):
-            params, opt_state = carry
-            part, k = inputs
-            (_, metrics), params, opt_state = step(params, normalizer, part, k, optimizer_state=opt_state)
-            return (params, opt_state), metrics
-
-        def epoch(carry, k):
-            k_perm, k_mb = jax.random.split(k)
-            perm = jax.random.permutation(k_perm, config.num_envs)
-            parts = jax.tree.map(lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), batch)
-            return jax.lax.scan(minibatch, carry, (parts, jax.random.split(k_mb, config.num_minibatches)))
-
         rate = planner_learning_rate(config, state.env_steps)
-        (params, opt_state), metrics = jax.lax.scan(
-            epoch,
-            (state.params, with_learning_rate(state.optimizer_state, rate)),
-            jax.random.split(key, config.num_epochs),
+        params, opt_state, losses = sgd_epochs(
+            config,
+            step,
+            normalizer,
+            state.params,
+            with_learning_rate(state.optimizer_state, rate),
+            batch,
+            key,
         )
         state = state.replace(
             params=params,
@@ -226,7 +224,7 @@ def make_planner_fns(config: TrainConfig):
             env_steps=state.env_steps + kept.astype(jnp.int32),
             iteration=state.iteration + 1,
         )
-        return state, {**{f"loss/{k}": v.mean() for k, v in metrics.items()}, "learning_rate": rate}
+        return state, {**losses, "learning_rate": rate}
 
     return jax.jit(rollout), jax.jit(update)
 

@@ -197,26 +197,48 @@ def _sgd(config: TrainConfig, network, optimizer, state: TrainState, data: Trans
         vf_coefficient=config.vf_coefficient,
     )
     update = gradients.gradient_update_fn(loss_fn, optimizer, pmap_axis_name=None, has_aux=True)
+    params, opt_state, metrics = sgd_epochs(
+        config, update, state.normalizer, state.params, state.optimizer_state, data, key
+    )
+    return state.replace(params=params, optimizer_state=opt_state), metrics
+
+
+def sgd_epochs(config: TrainConfig, update, normalizer, params, optimizer_state, data, key):
+    """`num_epochs` passes of `num_minibatches` gradient steps over one batch (geometric and
+    planner PPO alike).
+
+    Each epoch shuffles the batch's leading axis (`num_envs` episodes) and splits it into
+    `num_minibatches` equal parts, one gradient step each.
+
+    Args:
+        config: num_envs, num_epochs, num_minibatches.
+        update: a Brax `gradients.gradient_update_fn` of the loss, called as
+            `update(params, normalizer, minibatch, key, optimizer_state=...)`.
+        normalizer: observation statistics the loss normalises with (fixed here).
+        params, optimizer_state: the network's, before the epochs.
+        data: pytree of [num_envs, T, ...] arrays.
+        key: PRNG key.
+
+    Returns:
+        (params, optimizer_state, {"loss/<name>": mean over every step}).
+    """
 
     def minibatch(carry, inputs):
         params, opt_state = carry
-        batch, k = inputs
-        (_, metrics), params, opt_state = update(
-            params, state.normalizer, batch, k, optimizer_state=opt_state
-        )
+        part, k = inputs
+        (_, metrics), params, opt_state = update(params, normalizer, part, k, optimizer_state=opt_state)
         return (params, opt_state), metrics
 
     def epoch(carry, k):
         k_perm, k_mb = jax.random.split(k)
         perm = jax.random.permutation(k_perm, config.num_envs)
-        shuffled = jax.tree.map(lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), data)
-        return jax.lax.scan(minibatch, carry, (shuffled, jax.random.split(k_mb, config.num_minibatches)))
+        parts = jax.tree.map(lambda x: x[perm].reshape((config.num_minibatches, -1) + x.shape[1:]), data)
+        return jax.lax.scan(minibatch, carry, (parts, jax.random.split(k_mb, config.num_minibatches)))
 
-    (params, opt_state), metrics = jax.lax.scan(
-        epoch, (state.params, state.optimizer_state), jax.random.split(key, config.num_epochs)
+    (params, optimizer_state), metrics = jax.lax.scan(
+        epoch, (params, optimizer_state), jax.random.split(key, config.num_epochs)
     )
-    metrics = {f"loss/{k}": v.mean() for k, v in metrics.items()}
-    return state.replace(params=params, optimizer_state=opt_state), metrics
+    return params, optimizer_state, {f"loss/{k}": v.mean() for k, v in metrics.items()}
 
 
 def flat_batch_networks(network: ppo_networks.PPONetworks) -> ppo_networks.PPONetworks:

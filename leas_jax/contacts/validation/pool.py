@@ -15,7 +15,10 @@ hpp-centroidal-dynamics), so the paths are spread over worker processes:
 Design points (why):
 
 * Processes are started with `spawn` (default) or `forkserver`, never `fork`:
-  the parent usually holds JAX/XLA threads, which do not survive a fork.
+  the parent usually holds JAX/XLA threads, which do not survive a fork. A spawned
+  worker imports the caller's main script again, so a script must start its pool
+  under `if __name__ == "__main__":`; one that does not gets a `ValidationPoolError`
+  saying so (`process.refuse_bootstrap_start`), not a bare start-up failure.
 * Each worker loads the terrain (sent once, as its TOML text) and builds the
   planner (Talos model, sample database) once, in its start-up phase, then
   plans any number of paths. A long-lived `ValidationPool` keeps its workers
@@ -25,7 +28,9 @@ Design points (why):
   derived from the path's index only (`path_seed`). Nothing random is shared.
 * A worker that dies while planning a path (segfault, `os._exit`, SIGKILL by the
   OOM killer) is detected through its process sentinel; the path is retried
-  once on a fresh worker, then reported as an error `PathResult` for that path.
+  once on a fresh worker, then reported as an error `PathResult` for that path;
+  each death is logged (a warning on the `leas_jax.contacts.validation.process`
+  logger naming the worker's pid and the path).
   A path that runs longer than `task_timeout` gets its worker killed and is
   reported as an error (not retried: planning is deterministic, a rerun would
   time out again). Paths are never silently dropped and the caller never
@@ -42,6 +47,11 @@ Design points (why):
   `WorkerSpec` and runs `PathRunner(spec).run(...)` on its remote workers, so
   planning semantics (seeding, error capture, result type) stay identical.
 
+Where things live: this module is the interface (`ValidationPool`, `validate_paths`);
+`runner` plans one path in a worker (`PathRunner`, `PathResult`, `WorkerSpec`);
+`backend` holds the executor protocol, the in-process backend and `register_backend`;
+`process` the local worker processes; `ray_backend` the Ray actors.
+
 Test hook: `plan_fn=` replaces `plan_contacts` with any picklable module-level
 function of the same signature `(terrain, guide, timestep, config) -> plan`,
 where `plan` has `coverage` and `last_valid_index` attributes. The test suite
@@ -51,28 +61,31 @@ errors; production code leaves it at None.
 
 from __future__ import annotations
 
-import collections
-import dataclasses
 import importlib
-import itertools
 import math
-import multiprocessing
 import os
-import random
-import signal
-import threading
-import time
-import traceback as traceback_module
 import weakref
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
-from dataclasses import dataclass, field
-from multiprocessing.connection import wait as wait_for_ready
-from typing import Any, Protocol
 
 import numpy as np
 
-from leas_jax.errors import LeasError, UsageError
+from leas_jax.contacts.validation.backend import (
+    _BACKENDS,
+    _BUILTIN_BACKENDS,
+    Backend,
+    _InlineBackend,
+    register_backend,
+)
+from leas_jax.contacts.validation.process import _ProcessBackend
+from leas_jax.contacts.validation.runner import (
+    PathResult,
+    PathRunner,
+    ValidationPoolError,
+    WorkerSpec,
+    path_seed,
+)
+from leas_jax.errors import UsageError
 
 # Default cap on the wall time of one path. A 400-step guide subsampled every
 # 5th pose is 80 contact-planning stages; the generator should take seconds, so
@@ -81,645 +94,6 @@ DEFAULT_TASK_TIMEOUT = 600.0  # s
 # A path is started at most this many times: once, plus one retry after its
 # worker died (the brief of docs/design.md §7: retried once, then an error).
 DEFAULT_MAX_ATTEMPTS = 2
-# Workers that die before they report ready this many times in a row mean the
-# start-up itself is broken (bad install, bad plan_fn): fail instead of
-# respawning forever.
-_MAX_STARTUP_DEATHS = 3
-# How long close() waits for a worker to exit after asking it to, before SIGKILL.
-_STOP_GRACE = 5.0  # s
-# Upper bound of one wait in the dispatcher loop: bounds how late a task timeout
-# is noticed when nothing else happens.
-_POLL_INTERVAL = 0.5  # s
-
-
-class ValidationPoolError(LeasError):
-    """The pool cannot plan at all (worker start-up failed, pool closed, bad address)."""
-
-
-@dataclass(frozen=True)
-class PathResult:
-    """Outcome of the contact generator on one guide path.
-
-    Equality compares `index`, `coverage`, `last_valid_index`, `error` and
-    `attempts`; `plan`, `seconds` and `traceback` are excluded (arrays and
-    timings: compare plans array by array).
-
-    Attributes:
-        index: position of the guide in the submitted list.
-        coverage: arc-length fraction of the guide covered by the plan, in
-            [0, 1]; 0.0 when `error` is set.
-        last_valid_index: guide index of the last valid posture (docs/design.md §6);
-            -1 when `error` is set (no part of the guide was validated).
-        plan: the `ContactPlan`; None when `error` is set or the pool was made
-            with `return_plans=False`.
-        error: None on success, else one line "Type: message" (an exception
-            raised by the planner, a worker death, a timeout).
-        attempts: how many times the path was started (2 after a worker died
-            once under it).
-        seconds: wall time of the last attempt, s.
-        traceback: the formatted traceback of a planner exception, else None.
-    """
-
-    index: int
-    coverage: float
-    last_valid_index: int
-    plan: Any = field(compare=False, repr=False)
-    error: str | None
-    attempts: int
-    seconds: float = field(default=0.0, compare=False)
-    traceback: str | None = field(default=None, compare=False, repr=False)
-
-    @property
-    def ok(self) -> bool:
-        """True when the generator returned a plan (which may still cover little of the guide)."""
-        return self.error is None
-
-
-@dataclass(frozen=True)
-class WorkerSpec:
-    """Everything a worker needs to build its planner; picklable, sent once per worker.
-
-    Attributes:
-        terrain_text: the terrain file text (TOML, docs/design.md §4).
-        terrain_source: name used in terrain error messages (file path or "<...>").
-        config: the generator config (`GeneratorConfig`), None for its defaults.
-        plan_fn: None for `leas_jax.contacts.plan_contacts`, else a picklable
-            module-level function `(terrain, guide [T, 4], timestep, config) -> plan`.
-        return_plans: False to drop each plan in the worker and send back only
-            coverage and last_valid_index (the trainer needs no more; a plan
-            carries the terrain text, ~40 kB for the training arena).
-    """
-
-    terrain_text: str
-    terrain_source: str = "<terrain>"
-    config: Any = None
-    plan_fn: Callable | None = None
-    return_plans: bool = True
-
-
-def path_seed(base_seed: int, index: int) -> int:
-    """Seed of the path at `index`: a function of (base_seed, index) only.
-
-    Uses NumPy's SeedSequence so neighbouring indices give unrelated streams.
-
-    Returns:
-        int in [0, 2**32).
-    """
-    return int(np.random.SeedSequence([int(base_seed) & 0xFFFFFFFF, int(index)]).generate_state(1)[0])
-
-
-def _one_line(exc: BaseException) -> str:
-    """'Type: first line of the message' of an exception."""
-    text = str(exc).strip().splitlines()
-    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
-
-
-class PathRunner:
-    """Plans single paths; lives in a worker (or in the caller for workers=0). Host-only.
-
-    Built once per worker from a `WorkerSpec`: loads the terrain and, for the
-    default planner, one `ContactGenerator` (Talos model, sample database,
-    terrain collision objects, support surfaces), reused for every path. A
-    remote backend (see `register_backend`) instantiates it on its workers.
-
-    The generator is deterministic given (terrain, guide, timestep, config);
-    `GeneratorConfig` has no seed field, so the path seed only reaches the
-    global NumPy and `random` generators. An injected `plan_fn` whose config
-    has a `seed` field gets the path seed there too.
-
-    Args:
-        spec: terrain text, config and planner.
-    """
-
-    def __init__(self, spec: WorkerSpec):
-        from leas_jax.terrain import loads_terrain
-
-        self.terrain = loads_terrain(spec.terrain_text, source=spec.terrain_source)
-        self.return_plans = spec.return_plans
-        self._generator = None
-        if spec.plan_fn is None:
-            # Imported here, not at module level: leas_jax.contacts imports this
-            # module lazily, and only workers need the generator.
-            from leas_jax.contacts.planner.generator import ContactGenerator, GeneratorConfig
-
-            self.config = spec.config if spec.config is not None else GeneratorConfig()
-            self._generator = ContactGenerator(self.terrain, self.config)
-            self.plan_fn = None
-        else:
-            self.config = spec.config
-            self.plan_fn = spec.plan_fn
-
-    def _config_for(self, seed: int):
-        """The config with its `seed` field (if it has one) set to the path seed."""
-        config = self.config
-        if dataclasses.is_dataclass(config) and any(f.name == "seed" for f in dataclasses.fields(config)):
-            config = dataclasses.replace(config, seed=seed)
-        return config
-
-    def _plan(self, guide: np.ndarray, timestep: float, seed: int):
-        if self._generator is not None:
-            return self._generator.plan(guide, timestep)
-        return self.plan_fn(self.terrain, guide, timestep, self._config_for(seed))
-
-    def run(self, index: int, guide: np.ndarray, timestep: float, seed: int, attempts: int = 1) -> PathResult:
-        """Plan one path; planner exceptions become an error result.
-
-        Args:
-            index: position of the guide in its batch (copied to the result).
-            guide: [T, 4] (x, y, z, yaw) root poses, world frame.
-            timestep: s between guide poses.
-            seed: path seed (`path_seed`); seeds the global NumPy and `random`
-                generators and the config's `seed` field when it has one.
-            attempts: attempt number, copied to the result.
-        """
-        # Global generators too: planner code that draws from them must not
-        # depend on what this worker planned before.
-        np.random.seed(seed)
-        random.seed(seed)
-        start = time.perf_counter()
-        try:
-            plan = self._plan(guide, timestep, seed)
-            coverage = float(plan.coverage)
-            last_valid = int(plan.last_valid_index)
-        except Exception as exc:
-            return PathResult(
-                index=index,
-                coverage=0.0,
-                last_valid_index=-1,
-                plan=None,
-                error=_one_line(exc),
-                attempts=attempts,
-                seconds=time.perf_counter() - start,
-                traceback=traceback_module.format_exc(),
-            )
-        return PathResult(
-            index=index,
-            coverage=coverage,
-            last_valid_index=last_valid,
-            plan=plan if self.return_plans else None,
-            error=None,
-            attempts=attempts,
-            seconds=time.perf_counter() - start,
-        )
-
-
-def _worker_main(conn, spec: WorkerSpec) -> None:
-    """Worker process: build a PathRunner, then answer tasks until told to stop.
-
-    Protocol (parent -> worker): `(key, index, guide, timestep, seed, attempts)`
-    per path, None to stop. Worker -> parent: `("ready", pid)` once,
-    `("init_error", message, traceback)` if start-up failed, `("done", key,
-    PathResult)` per path. The worker exits when the parent's end of the pipe
-    closes, so an abandoned worker never outlives its parent's pool.
-    """
-    # Ctrl-C goes to the whole process group; the parent decides what to do
-    # (close the pool), a worker dying on SIGINT would only look like a crash.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        runner = PathRunner(spec)
-    except BaseException as exc:  # noqa: BLE001 - anything here is reported to the parent
-        conn.send(("init_error", _one_line(exc), traceback_module.format_exc()))
-        return
-    conn.send(("ready", os.getpid()))
-    while True:
-        try:
-            message = conn.recv()
-        except (EOFError, OSError):
-            return
-        if message is None:
-            return
-        key, index, guide, timestep, seed, attempts = message
-        result = runner.run(index, guide, timestep, seed, attempts)
-        try:
-            conn.send(("done", key, result))
-        except (EOFError, OSError, BrokenPipeError):
-            return
-        except Exception as exc:  # the plan could not be pickled
-            conn.send(
-                (
-                    "done",
-                    key,
-                    dataclasses.replace(
-                        result,
-                        plan=None,
-                        coverage=0.0,
-                        last_valid_index=-1,
-                        error=f"result of path {index} could not be sent back: {_one_line(exc)}",
-                    ),
-                )
-            )
-
-
-# --------------------------------------------------------------------------- backends
-
-
-class Backend(Protocol):
-    """What `ValidationPool` needs from an executor (local processes, inline, remote).
-
-    `submit` must not block on planning; each returned future resolves to one
-    `PathResult` per guide, in order, with `PathResult.index == position`.
-    """
-
-    workers: int
-
-    def submit(self, guides: list[np.ndarray], timestep: float, seeds: list[int]) -> Future: ...
-
-    def close(self, cancel_pending: bool = False) -> None: ...
-
-
-class _InlineBackend:
-    """workers=0: plan in the calling thread, synchronously inside submit."""
-
-    workers = 0
-
-    def __init__(self, spec: WorkerSpec):
-        self._runner = PathRunner(spec)
-        self._closed = False
-
-    def submit(self, guides, timestep, seeds):
-        if self._closed:
-            raise ValidationPoolError("submit() on a closed ValidationPool")
-        future: Future = Future()
-        future.set_running_or_notify_cancel()
-        future.set_result(
-            [self._runner.run(i, g, timestep, s) for i, (g, s) in enumerate(zip(guides, seeds))]
-        )
-        return future
-
-    def close(self, cancel_pending=False):
-        self._closed = True
-
-
-@dataclass
-class _Job:
-    future: Future
-    results: list
-    remaining: int
-
-
-@dataclass
-class _Task:
-    job: _Job
-    index: int
-    guide: np.ndarray
-    timestep: float
-    seed: int
-    attempts: int = 0
-    key: int = 0
-
-
-@dataclass
-class _Worker:
-    process: Any
-    conn: Any
-    ready: bool = False
-    pid: int | None = None
-    task: _Task | None = None
-    task_started: float = 0.0
-    timed_out: bool = False
-    tasks_done: int = 0
-    retiring: bool = False
-    eof: bool = False  # its pipe is closed: watch only the sentinel (no busy loop on EOF)
-
-
-def _describe_exit(exitcode: int | None) -> str:
-    """Human text for a process exit code (negative = killed by that signal)."""
-    if exitcode is None:
-        return "exit status unknown"
-    if exitcode < 0:
-        try:
-            name = signal.Signals(-exitcode).name
-        except ValueError:
-            name = f"signal {-exitcode}"
-        return f"killed by {name}"
-    return f"exited with code {exitcode}"
-
-
-class _QueuedBackend:
-    """Job bookkeeping shared by the process and Ray backends.
-
-    `submit` queues one `_Task` per path of a `_Job`; the dispatcher thread
-    (`_thread`) hands tasks to workers and reports answers with `_complete`;
-    `_fail_jobs` fails every pending job. Subclasses create `_lock`, `_queue`,
-    `_live_jobs`, `_broken`, `_closing`, `_cancel` and `_thread`, and define
-    `_wake()` (interrupt the dispatcher's wait).
-    """
-
-    def submit(self, guides, timestep, seeds):
-        future: Future = Future()
-        future.set_running_or_notify_cancel()
-        if not guides:
-            future.set_result([])
-            return future
-        job = _Job(future=future, results=[None] * len(guides), remaining=len(guides))
-        with self._lock:
-            if self._broken is not None:
-                raise ValidationPoolError(f"the validation pool is broken: {self._broken}")
-            if self._closing:
-                raise ValidationPoolError("submit() on a closed ValidationPool")
-            self._live_jobs[id(job)] = job
-            for index, (guide, seed) in enumerate(zip(guides, seeds)):
-                self._queue.append(_Task(job=job, index=index, guide=guide, timestep=timestep, seed=seed))
-        self._wake()
-        return future
-
-    def close(self, cancel_pending=False):
-        with self._lock:
-            self._closing = True
-            self._cancel = self._cancel or cancel_pending
-        self._wake()
-        if threading.current_thread() is not self._thread:
-            self._thread.join()
-
-    def _complete(self, task: _Task, result: PathResult) -> None:
-        """Record one path's result (the first answer wins); resolve the job when it is whole."""
-        job = task.job
-        if job.results[task.index] is not None:
-            return
-        job.results[task.index] = result
-        job.remaining -= 1
-        if job.remaining == 0:
-            self._live_jobs.pop(id(job), None)
-            job.future.set_result(job.results)
-
-    def _fail_jobs(self, exc: BaseException) -> None:
-        """Fail every pending job with `exc`; later submits raise (caller holds the lock)."""
-        self._broken = exc
-        self._queue.clear()
-        for job in list(self._live_jobs.values()):
-            if not job.future.done():
-                job.future.set_exception(exc)
-        self._live_jobs.clear()
-
-
-class _ProcessBackend(_QueuedBackend):
-    """Local worker processes driven by one dispatcher thread in the parent.
-
-    The dispatcher owns all pipes and processes: it hands one task at a time to
-    each ready worker (so it always knows which path a dead worker was
-    planning), reads results, watches process sentinels for deaths and
-    in-flight tasks for timeouts, respawns workers and completes futures.
-    """
-
-    def __init__(
-        self,
-        spec: WorkerSpec,
-        workers: int,
-        *,
-        task_timeout: float | None,
-        max_attempts: int,
-        max_tasks_per_worker: int | None,
-        start_method: str,
-    ):
-        self.workers = workers
-        self._spec = spec
-        self._context = multiprocessing.get_context(start_method)
-        self._task_timeout = task_timeout
-        self._max_attempts = max_attempts
-        self._max_tasks = max_tasks_per_worker
-        # Re-entrant: a done-callback of a future runs in the dispatcher thread
-        # with the lock held and may call submit().
-        self._lock = threading.RLock()
-        self._queue: collections.deque[_Task] = collections.deque()
-        self._keys = itertools.count()
-        self._live_jobs: dict[int, _Job] = {}
-        self._pool: list[_Worker] = []
-        self._closing = False
-        self._cancel = False
-        self._broken: BaseException | None = None
-        self._startup_deaths = 0
-        # Self-pipe: submit/close wake the dispatcher out of its wait().
-        self._wake_reader, self._wake_writer = multiprocessing.Pipe(duplex=False)
-        with self._lock:
-            self._spawn_missing()
-        self._thread = threading.Thread(target=self._run, name="leas-validation-pool", daemon=True)
-        self._thread.start()
-
-    # ---------------------------------------------------------------- dispatcher
-    def _wake(self) -> None:
-        try:
-            self._wake_writer.send_bytes(b"w")
-        except OSError:
-            pass
-
-    def _spawn_missing(self) -> None:
-        """Start workers until `self.workers` are alive (caller holds the lock)."""
-        alive = sum(1 for w in self._pool if not w.retiring)
-        for _ in range(self.workers - alive):
-            parent_conn, child_conn = self._context.Pipe(duplex=True)
-            process = self._context.Process(
-                target=_worker_main, args=(child_conn, self._spec), name="leas-contact-worker", daemon=True
-            )
-            process.start()
-            # Only the child keeps its end: then the parent sees EOF when it dies.
-            child_conn.close()
-            self._pool.append(_Worker(process=process, conn=parent_conn))
-
-    def _assign(self) -> None:
-        """Give queued tasks to idle ready workers (caller holds the lock)."""
-        for worker in self._pool:
-            if not self._queue:
-                return
-            if not worker.ready or worker.task is not None or worker.retiring:
-                continue
-            task = self._queue.popleft()
-            task.attempts += 1
-            task.key = next(self._keys)
-            worker.task, worker.task_started, worker.timed_out = task, time.monotonic(), False
-            try:
-                worker.conn.send((task.key, task.index, task.guide, task.timestep, task.seed, task.attempts))
-            except (OSError, BrokenPipeError):
-                # The worker died between its last message and now; its
-                # sentinel fires on the next wait and _on_death handles the task.
-                pass
-
-    def _on_message(self, worker: _Worker, message) -> None:
-        kind = message[0]
-        if kind == "ready":
-            worker.ready, worker.pid = True, message[1]
-            self._startup_deaths = 0
-        elif kind == "init_error":
-            self._break(ValidationPoolError(f"contact worker start-up failed: {message[1]}\n{message[2]}"))
-        elif kind == "done":
-            _, key, result = message
-            task = worker.task
-            if task is None or task.key != key:
-                return  # stale answer of a task already timed out
-            worker.task = None
-            worker.tasks_done += 1
-            self._complete(task, result)
-            if self._max_tasks is not None and worker.tasks_done >= self._max_tasks:
-                # Recycle: bounds memory growth of long-lived C++ planners.
-                worker.retiring = True
-                try:
-                    worker.conn.send(None)
-                except OSError:
-                    pass
-
-    def _on_death(self, worker: _Worker) -> None:
-        worker.process.join(timeout=1.0)
-        self._pool.remove(worker)
-        worker.conn.close()
-        task = worker.task
-        if not worker.ready and not worker.retiring:
-            self._startup_deaths += 1
-            if self._startup_deaths >= _MAX_STARTUP_DEATHS:
-                self._break(
-                    ValidationPoolError(
-                        f"{self._startup_deaths} contact workers died during start-up "
-                        f"(last {_describe_exit(worker.process.exitcode)})"
-                    )
-                )
-        if task is None:
-            return
-        pid = worker.pid if worker.pid is not None else worker.process.pid
-        if worker.timed_out:
-            self._complete(
-                task,
-                PathResult(
-                    index=task.index,
-                    coverage=0.0,
-                    last_valid_index=-1,
-                    plan=None,
-                    error=f"TimeoutError: path {task.index} took longer than {self._task_timeout:g} s "
-                    f"(worker pid {pid} killed)",
-                    attempts=task.attempts,
-                    seconds=time.monotonic() - worker.task_started,
-                ),
-            )
-            return
-        how = _describe_exit(worker.process.exitcode)
-        if task.attempts < self._max_attempts:
-            # Front of the queue: the retry should not wait behind later batches.
-            self._queue.appendleft(task)
-        else:
-            self._complete(
-                task,
-                PathResult(
-                    index=task.index,
-                    coverage=0.0,
-                    last_valid_index=-1,
-                    plan=None,
-                    error=f"WorkerDied: contact worker (pid {pid}) {how} while planning path "
-                    f"{task.index}, on each of {task.attempts} attempts",
-                    attempts=task.attempts,
-                    seconds=time.monotonic() - worker.task_started,
-                ),
-            )
-
-    def _check_timeouts(self) -> float:
-        """Kill workers over the task timeout; return seconds until the next deadline."""
-        if self._task_timeout is None:
-            return _POLL_INTERVAL
-        now, next_deadline = time.monotonic(), _POLL_INTERVAL
-        for worker in self._pool:
-            if worker.task is None or worker.timed_out:
-                continue
-            left = worker.task_started + self._task_timeout - now
-            if left <= 0:
-                worker.timed_out = True
-                worker.process.kill()
-            else:
-                next_deadline = min(next_deadline, left)
-        return max(next_deadline, 0.01)
-
-    def _break(self, exc: BaseException) -> None:
-        """Fail every pending job with `exc`; later submits raise (caller holds the lock)."""
-        self._fail_jobs(exc)
-        for worker in self._pool:
-            worker.task = None
-
-    def _idle(self) -> bool:
-        return not self._queue and all(w.task is None for w in self._pool)
-
-    def _run(self) -> None:
-        try:
-            while True:
-                with self._lock:
-                    if self._closing and (self._cancel or self._broken is not None or self._idle()):
-                        break
-                    if self._broken is None:
-                        self._spawn_missing()
-                        self._assign()
-                    timeout = self._check_timeouts()
-                    watched = {self._wake_reader: None}
-                    for worker in self._pool:
-                        if not worker.eof:
-                            watched[worker.conn] = worker
-                        watched[worker.process.sentinel] = worker
-                for ready in wait_for_ready(list(watched), timeout=timeout):
-                    if ready is self._wake_reader:
-                        while self._wake_reader.poll():
-                            self._wake_reader.recv_bytes()
-                        continue
-                    worker = watched[ready]
-                    with self._lock:
-                        if worker not in self._pool:
-                            continue
-                        # Drain answers first: a worker may send its result and die.
-                        try:
-                            while not worker.eof and worker.conn.poll():
-                                self._on_message(worker, worker.conn.recv())
-                        except (EOFError, OSError):
-                            worker.eof = True
-                        if not worker.process.is_alive():
-                            self._on_death(worker)
-        except BaseException as exc:  # noqa: BLE001 - a dispatcher bug must not hang callers
-            with self._lock:
-                self._break(ValidationPoolError(f"validation dispatcher failed: {_one_line(exc)}"))
-        finally:
-            with self._lock:
-                if self._live_jobs:
-                    self._break(ValidationPoolError("ValidationPool closed with paths pending"))
-                workers = list(self._pool)
-                self._pool.clear()
-            _stop_workers(workers)
-            self._wake_reader.close()
-            self._wake_writer.close()
-
-
-def _stop_workers(workers: list[_Worker]) -> None:
-    """Ask workers to exit, then SIGKILL those still alive after a grace period."""
-    for worker in workers:
-        try:
-            worker.conn.send(None)
-        except OSError:
-            pass
-    deadline = time.monotonic() + _STOP_GRACE
-    for worker in workers:
-        worker.process.join(timeout=max(0.0, deadline - time.monotonic()))
-        if worker.process.is_alive():
-            worker.process.kill()
-            worker.process.join(timeout=1.0)
-        worker.conn.close()
-
-
-# A remote backend factory: (address, spec, workers, options) -> Backend.
-BackendFactory = Callable[[str, WorkerSpec, "int | None", dict], Backend]
-_BACKENDS: dict[str, BackendFactory] = {}
-# Backends shipped with leas-jax: the module registers itself when imported, on first use.
-_BUILTIN_BACKENDS = {
-    "ray": "leas_jax.contacts.validation.ray_backend",
-    "auto": "leas_jax.contacts.validation.ray_backend",
-    "local": "leas_jax.contacts.validation.ray_backend",
-}
-
-
-def register_backend(scheme: str, factory: BackendFactory) -> None:
-    """Register the executor used for `ValidationPool(address="<scheme>://...")`.
-
-    The Ray backend (`leas_jax.contacts.validation.ray_backend`, schemes "ray", "auto"
-    and "local") is registered this way when first used; it is the example to
-    follow for another executor.
-
-    Args:
-        scheme: the part of the address before "://" (or the whole address,
-            e.g. "auto"), case-sensitive.
-        factory: called as `factory(address, spec, workers, options)` where
-            `options` holds task_timeout, max_attempts, max_tasks_per_worker;
-            returns an object with the `Backend` protocol.
-    """
-    _BACKENDS[scheme] = factory
 
 
 def available_cpus() -> int:
@@ -966,3 +340,19 @@ def validate_paths(
         return_plans=return_plans,
     ) as pool:
         return pool.map(checked, timestep)
+
+
+__all__ = [
+    "DEFAULT_MAX_ATTEMPTS",
+    "DEFAULT_TASK_TIMEOUT",
+    "Backend",
+    "PathResult",
+    "PathRunner",
+    "ValidationPool",
+    "ValidationPoolError",
+    "WorkerSpec",
+    "available_cpus",
+    "path_seed",
+    "register_backend",
+    "validate_paths",
+]

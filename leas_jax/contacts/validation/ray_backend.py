@@ -51,18 +51,20 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
-from leas_jax.contacts.validation.pool import (
+from leas_jax.contacts.validation.backend import (
     _MAX_STARTUP_DEATHS,
     _POLL_INTERVAL,
+    _Job,
+    _QueuedBackend,
+    _Task,
+    register_backend,
+)
+from leas_jax.contacts.validation.runner import (
     PathResult,
     PathRunner,
     ValidationPoolError,
     WorkerSpec,
-    _Job,
     _one_line,
-    _QueuedBackend,
-    _Task,
-    register_backend,
 )
 from leas_jax.errors import UsageError
 

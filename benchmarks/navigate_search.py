@@ -1,0 +1,126 @@
+"""The global layer: the lattice search against RBKino+RRT on the evaluation scenarios' starts.
+
+For each scenario's seeded starts (the same draws as `leas evaluate`), in one process:
+  - the lattice search (`leas_jax.navigate`): the valid set over 0.05 m cells x 16 headings,
+    built once per terrain (timed apart), then one Dijkstra per start to the target;
+  - the RBKino+RRT (`leas_jax.steering.rrt.plan_rrt`, its default budget, seed = start index,
+    as `leas evaluate` runs it).
+Reports, per planner, how many starts get a path (with 95 % Wilson intervals) and the
+median / p95 seconds per start, and their ratio. Geometric planners only: what the contact
+generator makes of the paths is `leas evaluate --methods ...,navigate`'s question.
+
+    python benchmarks/navigate_search.py [--scenarios bridge hole] [--n-starts 60] [--rrt-starts N]
+
+Writes results/navigate_search.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+
+import numpy as np
+from common import save
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a proportion k / n, in %."""
+    if n == 0:
+        return (float("nan"), float("nan"))
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (100 * (centre - half), 100 * (centre + half))
+
+
+def summary(found: list[bool], seconds: list[float]) -> dict:
+    k, n = int(sum(found)), len(found)
+    return {
+        "n": n,
+        "found": k,
+        "percent": 100.0 * k / n if n else float("nan"),
+        "wilson95": wilson(k, n),
+        "median_s": float(np.median(seconds)),
+        "p95_s": float(np.percentile(seconds, 95)),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenarios", nargs="+", default=["bridge", "hole"])
+    parser.add_argument("--n-starts", type=int, default=60)
+    parser.add_argument("--rrt-starts", type=int, default=None, help="RRT on the first N starts only")
+    args = parser.parse_args()
+
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.eval.scenarios import cells_for, draw_starts, scenario_file
+    from leas_jax.navigate.lattice import build_lattice
+    from leas_jax.navigate.search import SearchConfig, graph, search
+    from leas_jax.steering.baselines import BaselineConfig
+    from leas_jax.steering.rrt import RRTConfig, plan_rrt
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training import load_policy
+
+    policy = load_policy("checkpoints/leas_talos")
+    env = policy.config.env
+    config = BaselineConfig.from_env(env)
+    load_before = os.getloadavg()
+    report = {"load_average_before": load_before, "scenarios": {}}
+    for name in args.scenarios:
+        terrain = load_terrain(scenario_file(name))
+        scenario = terrain.scenario
+        field = heightfield_from_terrain(terrain, env)
+        (cell,) = cells_for(name, scenario)
+        starts = draw_starts(
+            scenario, cell, args.n_starts, scenario.seed, field, config.nominal_root_height, env.reachability
+        )
+        target = np.asarray(scenario.target, np.float64)
+        began = time.perf_counter()
+        lattice = build_lattice(field, terrain.bounds, env.nominal_root_height, env.reachability)
+        first = time.perf_counter() - began  # includes the jitted check's compilation
+        began = time.perf_counter()
+        lattice = build_lattice(field, terrain.bounds, env.nominal_root_height, env.reachability)
+        adjacency = graph(lattice, None, SearchConfig())
+        build = time.perf_counter() - began
+        lat_found, lat_s, lengths = [], [], []
+        for pose in starts.poses:
+            began = time.perf_counter()
+            found = search(lattice, pose[[0, 1, 3]], target, adjacency=adjacency)
+            lat_s.append(time.perf_counter() - began)
+            lat_found.append(bool(found.reached))
+            lengths.append(found.length)
+        rrt_found, rrt_s = [], []
+        n_rrt = args.rrt_starts or len(starts.poses)
+        for k, (pose, speed) in enumerate(zip(starts.poses[:n_rrt], starts.speeds[:n_rrt])):
+            began = time.perf_counter()
+            plan = plan_rrt(
+                field, pose, target, float(speed), terrain.bounds, config, RRTConfig(seed=k), env.reachability
+            )
+            rrt_s.append(time.perf_counter() - began)
+            rrt_found.append(bool(plan.success))
+            print(
+                f"{name} start {k}: lattice {lat_found[k]} {lat_s[k]:.2f} s, rrt {plan.success} {rrt_s[-1]:.1f} s",
+                flush=True,
+            )
+        lat = summary(lat_found, lat_s)
+        lat_same = summary(lat_found[:n_rrt], lat_s[:n_rrt])
+        rrt = summary(rrt_found, rrt_s)
+        report["scenarios"][name] = {
+            "lattice_shape": list(lattice.shape),
+            "lattice_build_s": build,
+            "lattice_first_build_s_with_compile": first,
+            "lattice": lat,
+            "lattice_on_rrt_starts": lat_same,
+            "lattice_path_length_median_m": float(np.median(lengths)),
+            "rrt": rrt,
+            "rrt_over_lattice_median_time": rrt["median_s"] / lat_same["median_s"],
+        }
+        print(name, report["scenarios"][name], flush=True)
+    report["load_average_after"] = os.getloadavg()
+    save("navigate_search", report)
+
+
+if __name__ == "__main__":
+    main()

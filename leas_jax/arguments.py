@@ -1,0 +1,53 @@
+"""Argument types and options shared by the command modules (`<package>.commands`).
+
+Apart from `leas_jax.cli` so that the command modules need not import the parser that
+imports them.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer > 0 (underscores allowed, as in 150_000)."""
+    try:
+        value = int(text.replace("_", ""))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def non_negative_seconds(text: str) -> float:
+    """argparse type: a finite number of seconds >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0, got {text!r}") from None
+    if not (value >= 0.0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got {text!r}")
+    return value
+
+
+def add_allow_pickle_argument(parser, what: str) -> None:
+    """`--allow-pickle`: read legacy pickle policies/checkpoints (they can run code when loaded)."""
+    parser.add_argument(
+        "--allow-pickle",
+        action="store_true",
+        help=f"also read {what} in the pickle format of earlier versions; unpickling a file can run "
+        "code from it, so only for files you trust (a warning is printed)",
+    )
+
+
+def add_ray_address_argument(parser, use: str) -> None:
+    """`--ray-address` of the commands that run the contact generator; `use` says what runs on Ray."""
+    parser.add_argument(
+        "--ray-address",
+        metavar="ADDRESS",
+        default=None,
+        help=f"{use} on Ray instead of local processes (pip install 'leas-jax[cluster]'): "
+        "ray://HOST:PORT (Ray client of a cluster), auto (the cluster this machine belongs "
+        "to) or local (a new local Ray instance)",
+    )

@@ -1,0 +1,85 @@
+"""Settings of the contact generator (docs/design.md §6); every stage reads them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from leas_jax.contacts.robot.database import DatabaseConfig
+from leas_jax.contacts.robot.model import FRICTION
+
+
+@dataclass(frozen=True)
+class GeneratorConfig:
+    """Settings of the contact generator; defaults from docs/design.md §6 and the Talos model.
+
+    A default chosen against a failure names the test that guards it
+    (tests/test_contacts_generator.py).
+    """
+
+    stride: int = 5  # guide poses per planning pose, docs/design.md §6 ("every 5th pose by default")
+    lookahead: float = 0.7  # s, where a moving foot should land on the guide, docs/design.md §6 (0.6-0.8 s)
+    mu: float = FRICTION  # friction coefficient, docs/design.md §6 checks 1 and 4
+    # m, horizontal lag of a foot behind its nominal place that makes it step. Small enough
+    # that on a slow climb (LeaS slows to ~0.06 m/s on eval_stairs, its root rising with each
+    # tread) the trailing foot follows before its leg is overstretched
+    # (test_slow_leas_climb_of_eval_stairs_is_covered); smaller means more footsteps on flat ground.
+    step_trigger: float = 0.07
+    step_trigger_yaw: float = 0.20  # rad, yaw lag that makes a foot step (~ pi/9 rad/s x 0.5 s x 1.15)
+    # Steps that bring their foot nearer its step target come first: the horizontal gap, in
+    # step triggers, cut by at least this much, or to under 1. Only when neither foot has such
+    # a step may one step with less. Without it, beside a void, a foot whose place is out of
+    # reach keeps stepping in place while the other, which could lead, never moves
+    # (test_the_foot_that_can_lead_steps_first_beside_a_void).
+    # None: any step, the most lagging foot first.
+    min_step_gain: float | None = 0.5
+    max_foot_offset: float = 0.25  # m, comfort region: sole to its nominal place in the root frame
+    # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward
+    max_foot_yaw: float = 0.5
+    max_steps_per_pose: int = 2  # steps per planning pose (0.5 s at the default stride and timestep)
+    max_root_offset_xy: float = (
+        0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
+    )
+    max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
+    min_knee: float = (
+        0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
+    )
+    candidate_radius: float = 0.15  # m, database samples this close to a step target are candidates
+    candidate_slab: float = 0.10  # m, samples this close (vertically) to a face are dropped on it
+    candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
+    max_candidates: int = 12  # candidates tried per step (in rank order)
+    # On a beam (a face narrower than `beam_width` across one of its edges), a sole turned
+    # by at most `beam_align_yaw` to the beam's axis is a candidate too, after the one at
+    # the guide's yaw at the same place. eval_bridge's 0.30 m beam leaves 2 cm beside two
+    # soles side by side; at 11 degrees off its axis they need 5 cm more, and guides wander
+    # that much (test_soles_turn_to_a_narrow_bridge_axis). Beams only: soles aligned to every
+    # face's edges miss stair treads. Walking along such a beam, each foot's step target also
+    # moves into its lane (`footholds.Footholds.beam_lane`).
+    beam_width: float = 0.5  # m; the arena's bridges are 0.30-0.45 m wide, its stair treads 0.30 m deep
+    beam_align_yaw: float = (
+        0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables (lanes too)
+    )
+    beam_drop: float = 0.05  # m, a beam's lanes need terrain this much lower this far beyond both its edges
+    # m, sole rectangle kept this far inside the face polygon (docs/design.md §6's 5 mm tolerance). Two
+    # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin, which must fit eval_bridge's
+    # 0.30 m (test_narrow_bridge_crossed_on_its_centre_line).
+    edge_margin: float = 0.005
+    cover_tol: float = (
+        0.005  # m, a sole is covered if the terrain rises more than this above it (docs/design.md §6: 5 mm)
+    )
+    feet_gap: float = 0.01  # m, minimal gap between the two sole rectangles (see edge_margin)
+    swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
+    swing_clearance: float = (
+        0.05  # m, how far out of its hip a lifted foot may be held (walking.Walking.step)
+    )
+    # m: where single support with the CoM over the stance sole's centre fails, the CoM is
+    # aimed instead at the point of that sole, this far inside its edges, nearest the guide
+    # root (a shorter root shift; eval_circuit's pillars). 3 cm leaves twice flat_com_margin. None: off.
+    single_support_com_inset: float | None = 0.03
+    min_robustness: float = (
+        1.0  # hpp-centroidal-dynamics robustness kept (>= 0 is the contract; ~3 mm of CoM margin)
+    )
+    # m, on horizontal faces a CoM this far inside the support polygon is in equilibrium
+    # without solving the LP (equilibrium.flat_support_margin); 1.5 cm is ~5 x the CoM
+    # margin of min_robustness, so the shortcut never accepts what the LP would reject
+    flat_com_margin: float = 0.015
+    database: DatabaseConfig = field(default_factory=DatabaseConfig)

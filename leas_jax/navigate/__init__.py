@@ -1,0 +1,32 @@
+"""Navigate: a verified whole-body contact plan from a start to a goal on any terrain.
+
+    from leas_jax.navigate import navigate
+    result = navigate(policy, terrain, start=(2.0, 4.0, 0.0), goal=(9.5, 5.0))
+    result.plan.save("plan.npz")              # passes `leas verify`
+
+Modules: lattice (the root's valid set over positions x headings, jitted), search (Dijkstra
+over the lattice), loop (closed loop with the LeaS policy and the contact generator),
+result (NavigationResult), commands (`leas navigate`), report (a navigate query as a
+report section). Attributes are imported lazily so
+that `import leas_jax.navigate` (and the CLI's parser) loads no JAX.
+"""
+
+import importlib
+
+_LAZY = {
+    "navigate": "leas_jax.navigate.loop",
+    "Navigator": "leas_jax.navigate.loop",
+    "NavigateConfig": "leas_jax.navigate.loop",
+    "Query": "leas_jax.navigate.loop",
+    "NavigationResult": "leas_jax.navigate.result",
+    "LatticeConfig": "leas_jax.navigate.lattice",
+    "SearchConfig": "leas_jax.navigate.search",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'leas_jax.navigate' has no attribute {name!r}")

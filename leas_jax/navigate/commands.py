@@ -1,0 +1,160 @@
+"""`leas navigate`: a verified contact plan from a start to a goal (host; JAX inside the command).
+
+    leas navigate --checkpoint DIR --terrain FILE --start X,Y,YAW --goal X,Y --out plan.npz
+                  [--html view.html] [--via X,Y ...] [--workers N] [--max-replans K]
+
+Progress goes to stderr, one line per step; the summary to stdout. The plan file is the
+docs/design.md §6 format (`ContactPlan.save`), so `leas verify` and `leas show` read it.
+Exit code 0: the goal is reached; 1: it is not (the best partial plan is written when the
+generator verified any posture); 2: bad input. Module-level imports stay light (no JAX):
+the CLI imports every command module to build its parser.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from leas_jax.errors import UsageError
+
+
+def _floats(count: int, name: str):
+    """argparse type: `count` finite comma-separated numbers."""
+
+    def parse(text: str) -> list[float]:
+        try:
+            values = [float(v) for v in text.split(",")]
+        except ValueError:
+            values = []
+        if len(values) != count or not all(math.isfinite(v) for v in values):
+            raise argparse.ArgumentTypeError(
+                f"{name} expects {count} finite comma-separated numbers, got {text!r}"
+            )
+        return values
+
+    return parse
+
+
+def _check_output(argument: str, path, suffix: str) -> Path:
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise UsageError(f"{argument}: {path}: directory {path.parent} does not exist")
+    if path.suffix != suffix:
+        raise UsageError(f"{argument}: {path}: expected a {suffix} file")
+    return path
+
+
+def navigate_config(args):
+    """`NavigateConfig` from the command's options."""
+    import dataclasses
+
+    from leas_jax.navigate.loop import NavigateConfig
+
+    config = NavigateConfig()
+    if args.max_replans < 0:
+        raise UsageError(f"--max-replans: expected an integer >= 0, got {args.max_replans}")
+    if not args.resolution > 0:
+        raise UsageError(f"--resolution: expected a positive number of metres, got {args.resolution}")
+    return dataclasses.replace(
+        config,
+        max_replans=args.max_replans,
+        lattice=dataclasses.replace(config.lattice, resolution=args.resolution),
+    )
+
+
+def cmd_navigate(args) -> int:
+    """Run one navigate query; write the plan (and the HTML view). Returns the exit code."""
+    out = _check_output("--out", args.out, ".npz")
+    html = None if args.html is None else _check_output("--html", args.html, ".html")
+    if args.workers < 0:
+        raise UsageError(f"--workers: expected an integer >= 0, got {args.workers}")
+    config = navigate_config(args)
+    from leas_jax.terrain import load_terrain
+
+    terrain = load_terrain(args.terrain)
+    if not Path(args.checkpoint).exists():
+        raise UsageError(f"--checkpoint: {args.checkpoint}: no such file or directory")
+    from leas_jax.training import load_policy
+
+    policy = load_policy(args.checkpoint)
+    x, y, yaw = args.start
+    start = (x, y, math.radians(yaw) if args.degrees else yaw)
+
+    def say(line: str) -> None:
+        print(line, file=sys.stderr, flush=True)
+
+    from leas_jax.navigate.loop import navigate
+
+    result = navigate(
+        policy,
+        terrain,
+        start,
+        args.goal,
+        config,
+        speed=args.speed,
+        via=args.via,
+        workers=args.workers,
+        progress=say,
+    )
+    seconds = result.seconds
+    split = ", ".join(f"{k} {seconds[k]:.2f} s" for k in ("lattice", "search", "rollout", "contact_planning"))
+    if result.plan is not None:
+        result.plan.save(out)
+    status = "reached" if result.success else f"not reached ({result.reason})"
+    print(f"navigate: {status}: {result.message}")
+    if result.plan is None:
+        print(f"no verified posture: {out} not written")
+    else:
+        print(
+            f"{out}: {len(result.plan)} postures, coverage {result.plan.coverage:.3f}, "
+            f"final distance {result.final_distance:.2f} m, {result.replans} replans"
+        )
+    print(f"time {seconds['total']:.2f} s ({split})")
+    if html is not None and result.plan is not None:
+        from leas_jax.contacts.viewer import write_html
+
+        write_html(result.plan, html)
+        print(f"wrote {html}")
+    return 0 if result.success else 1
+
+
+def register(subparsers) -> None:
+    """Add `navigate` to the `leas` parser."""
+    parser = subparsers.add_parser(
+        "navigate",
+        help="verified contact plan from a start to a goal",
+        description="Search the terrain's valid root poses (a lattice of positions x headings) for a "
+        "path to the goal, let the LeaS policy walk it, plan and verify contacts along the "
+        "guide, and search again around where the contact generator fails. Writes the "
+        "contact plan (docs/design.md §6 format; `leas verify` checks it). Exit code 0: "
+        "goal reached; 1: not reached (the best partial plan is written); 2: bad input.",
+    )
+    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
+    parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain file (TOML)")
+    parser.add_argument(
+        "--start",
+        required=True,
+        type=_floats(3, "--start"),
+        metavar="X,Y,YAW",
+        help="start position (m) and yaw (rad, or degrees with --degrees)",
+    )
+    parser.add_argument("--goal", required=True, type=_floats(2, "--goal"), metavar="X,Y", help="goal (m)")
+    parser.add_argument(
+        "--via",
+        type=_floats(2, "--via"),
+        action="append",
+        metavar="X,Y",
+        help="a point to pass before the goal (repeat, in order)",
+    )
+    parser.add_argument("--out", required=True, metavar="PLAN.npz", help="contact plan file")
+    parser.add_argument("--html", metavar="VIEW.html", help="also write the 3D view of the plan")
+    parser.add_argument("--degrees", action="store_true", help="YAW of --start is in degrees")
+    parser.add_argument("--speed", type=float, default=0.0, help="initial speed along the heading (m/s)")
+    parser.add_argument(
+        "--workers", type=int, default=1, help="contact-generator processes (0: in this process; default 1)"
+    )
+    parser.add_argument("--max-replans", type=int, default=3, help="searches after the first (default 3)")
+    parser.add_argument("--resolution", type=float, default=0.05, help="lattice cell size, m (default 0.05)")
+    parser.set_defaults(func=cmd_navigate)

@@ -1,0 +1,515 @@
+"""Navigate: a verified contact plan from a start to a goal (host loop around jitted JAX parts).
+
+One query runs, in a closed loop with the contact generator:
+
+1. search: the cheapest lattice path from the current pose through the remaining route points
+   to the goal (`search`, over the valid set of `lattice`), cut into waypoints;
+2. policy rollout: the LeaS policy walks along those waypoints (`steering.leas.rollout_batch`,
+   rolling on through poses the reachability condition rejects: the generator judges);
+3. contact planning: the generator validates the whole guide grown so far (the verified
+   prefix of the previous attempts plus the new segment; one `ValidationPool` task);
+4. where it stops short, the cells within `failure_radius` of where it failed are penalised,
+   and the search is repeated from a verified pose `backoff_distance` before its last valid
+   posture, at most `max_replans` times.
+
+The generator plans each grown guide from its start, so the returned plan is one continuous
+plan that `leas verify` checks like any other. Nothing in the loop is random: a query's
+answer is a function of the policy, the terrain, the query and the configs, whatever the
+number of workers or the other queries of a batch (`Navigator.run` runs many queries with
+their generator tasks in flight together, as `leas evaluate` does).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from leas_jax.errors import UsageError
+from leas_jax.navigate import result as reasons
+from leas_jax.navigate.lattice import LatticeConfig, build_lattice
+from leas_jax.navigate.result import Attempt, NavigationResult
+from leas_jax.navigate.search import SearchConfig, SearchResult, graph, search
+
+
+@dataclass(frozen=True)
+class NavigateConfig:
+    """Settings of the closed loop (the lattice's and the search's are nested)."""
+
+    lattice: LatticeConfig = LatticeConfig()
+    search: SearchConfig = SearchConfig()
+    max_replans: int = 3  # searches after the first one
+    # extra cost per m (on top of 1) of moving within failure_radius of a failure: 4 makes a
+    # detour up to 5 x the length of the penalised stretch cheaper than going through again
+    failure_penalty: float = 4.0
+    # m, about a step and a half of Talos. The penalised disk is centred failure_radius / 2
+    # ahead of the guide pose where the generator failed, along its heading: what stopped it
+    # (a foothold it could not find) lies ahead of the root, and the pose the search starts
+    # again from (backoff_distance before) then lies outside the disk.
+    failure_radius: float = 0.5
+    # m of verified guide given up before the failure: room for the policy to turn away (it
+    # turns at most omega_max = 0.35 rad/s while walking, a quarter turn takes ~0.5-0.8 m)
+    backoff_distance: float = 1.0
+    # LeaS horizon = this x the time to walk the waypoints at the target speed (eval's factor),
+    # rounded up to `horizon_quantum` steps so that queries share a few compiled rollouts
+    horizon_factor: float = 2.5
+    horizon_quantum: int = 200
+    via_radius: float = 0.5  # m: a route point counts as passed once the guide came this close
+    generator: object = None  # `GeneratorConfig` of the contact generator (None: its defaults)
+
+
+@dataclass(frozen=True)
+class Query:
+    """One navigate query.
+
+    Attributes:
+        start: [4] (x, y, z, yaw) world, z at the nominal height above the terrain.
+        speed: initial speed along the heading, m/s.
+        route: [R, 2] world points to visit in order, the goal last.
+    """
+
+    start: np.ndarray
+    speed: float
+    route: np.ndarray
+
+    @property
+    def goal(self) -> np.ndarray:
+        return self.route[-1]
+
+
+@dataclass
+class _State:
+    """A query in flight."""
+
+    query: Query
+    penalty: np.ndarray
+    guide: np.ndarray | None = None
+    segment_begin: int = 0
+    search: SearchResult | None = None
+    path: np.ndarray | None = None
+    waypoints: np.ndarray | None = None
+    attempts: list = field(default_factory=list)
+    best: tuple | None = None  # (final distance, plan, guide)
+    unreachable: str | None = None  # the first search reason that the goal cannot be reached
+    seconds: dict = field(default_factory=lambda: {"search": 0.0, "rollout": 0.0, "contact_planning": 0.0})
+    done: NavigationResult | None = None
+
+
+def _fmt(xy) -> str:
+    return "(" + ", ".join(f"{float(v):.2f}" for v in np.asarray(xy).reshape(-1)) + ")"
+
+
+class Navigator:
+    """The terrain's lattice and the policy, ready for any number of queries (host).
+
+    Args:
+        policy: a `leas_jax.training.Policy` (its env fixes the heightfield, the
+            reachability condition and the timestep).
+        terrain: a `leas_jax.terrain.Terrain`.
+        config: `NavigateConfig`.
+        progress: None, or a function str -> None that receives one line per step.
+    """
+
+    def __init__(self, policy, terrain, config: NavigateConfig = NavigateConfig(), progress=None):
+        from leas_jax.env import heightfield_from_terrain
+
+        self.policy, self.terrain, self.config = policy, terrain, config
+        self.env = policy.config.env
+        self.say = progress or (lambda message: None)
+        self.field = heightfield_from_terrain(terrain, self.env)
+        self._lattice = None
+        self.lattice_seconds = 0.0
+
+    @property
+    def lattice(self):
+        """The terrain's `Lattice` (built on first use, with the penalty-free search graph)."""
+        if self._lattice is None:
+            began = time.perf_counter()
+            cfg = self.config
+            self._lattice = build_lattice(
+                self.field,
+                self.terrain.bounds,
+                self.env.nominal_root_height,
+                self.env.reachability,
+                cfg.lattice,
+            )
+            self.graph = graph(self._lattice, None, cfg.search)
+            self.lattice_seconds = time.perf_counter() - began
+            nx, ny, nh = self._lattice.shape
+            self.say(
+                f"lattice: {nx} x {ny} cells x {nh} headings at {cfg.lattice.resolution:g} m, "
+                f"{100 * self._lattice.node_valid.mean():.1f} % valid ({self.lattice_seconds:.2f} s)"
+            )
+        return self._lattice
+
+    # ---- inputs -------------------------------------------------------------------------
+    def query(self, start, goal, speed: float = 0.0, via=None, name: str = "--start") -> Query:
+        """A checked `Query` from (x, y, yaw) or (x, y, z, yaw) and a goal (x, y).
+
+        Raises:
+            UsageError: the start or the goal lies off the terrain, or the start pose fails
+                the reachability condition (the message names the parts that fail).
+        """
+        from leas_jax.steering.leas import start_poses
+
+        start = np.asarray(start, np.float64).reshape(-1)
+        if len(start) not in (3, 4) or not np.isfinite(start).all():
+            raise UsageError(f"{name}: expected x, y, yaw (finite), got {start.tolist()}")
+        route = np.asarray([] if via is None else via, np.float64).reshape(-1, 2)
+        route = np.concatenate([route, np.asarray(goal, np.float64).reshape(1, 2)])
+        lo, hi = self.terrain.bounds
+        for label, xy in [(name, start[:2])] + [("--goal", p) for p in route]:
+            if not (np.isfinite(xy).all() and np.all(xy >= lo) and np.all(xy <= hi)):
+                raise UsageError(
+                    f"{label}: {_fmt(xy)} lies off the terrain {self.terrain.name} "
+                    f"(bounds {lo.tolist()} .. {hi.tolist()})"
+                )
+        pose = start_poses(
+            self.field, np.array([start[0], start[1], start[-1]]), self.env.nominal_root_height
+        )[0]
+        failing = self._failing_terms(pose)
+        if failing:
+            raise UsageError(
+                f"{name}: the start {_fmt(start)} is in collision or unsupported: the root pose "
+                f"fails the reachability condition ({', '.join(failing)})"
+            )
+        return Query(np.asarray(pose, np.float64), float(speed), route)
+
+    def _failing_terms(self, pose) -> list[str]:
+        """Names of the parts of the condition a pose [4] fails (solid_ground: the void under it)."""
+        import jax
+        import jax.numpy as jnp
+
+        from leas_jax.env import reachability
+        from leas_jax.steering.baselines import lift_checked
+
+        parts = jax.jit(reachability.terms, static_argnums=2)(
+            self.field, jnp.asarray(pose, jnp.float32), self.env.reachability
+        )
+        failing = [k for k, v in parts.items() if not bool(v)]
+        _, ok = lift_checked(
+            self.field, np.asarray(pose)[None, [0, 1, 3]], self.env.nominal_root_height, self.env.reachability
+        )
+        if not ok[0] and not failing:
+            failing = ["solid_ground"]
+        return failing
+
+    # ---- the parts of one attempt --------------------------------------------------------
+    def _route_search(self, state: _State, pose, route) -> SearchResult:
+        """Search leg by leg through the route points; stops at the first leg that fails."""
+        cfg = self.config.search
+        lattice = self.lattice
+        adjacency = graph(lattice, state.penalty, cfg) if state.penalty.any() else self.graph
+        paths, waypoints, current = [], [], np.asarray(pose, np.float64)[[0, 1, 3]]
+        for point in route:
+            leg = search(lattice, current, point, cfg, adjacency=adjacency)
+            paths.append(leg.path if not paths else leg.path[1:])
+            # a reached leg ends at the point itself (its goal node lies up to goal_radius off it,
+            # and the policy stops within switch distance of its last waypoint)
+            waypoints.append(
+                np.concatenate([leg.waypoints[:-1], point[None]]) if leg.reached else leg.waypoints
+            )
+            current = leg.path[-1]
+            if not leg.reached:
+                break
+        path = np.concatenate(paths)
+        return SearchResult(
+            reached=leg.reached,
+            reason=leg.reason,
+            path=path,
+            waypoints=np.concatenate(waypoints),
+            cost=float("nan"),
+            length=float(np.hypot(*np.diff(path[:, :2], axis=0).T).sum()) if len(path) > 1 else 0.0,
+            end_distance=leg.end_distance,
+        )
+
+    def _rollout(self, poses: np.ndarray, speeds: np.ndarray, waypoints: list) -> list[np.ndarray]:
+        """Guides of the policy from poses [N, 4] along each waypoint list [W_n, 2] (one jitted batch)."""
+        from leas_jax.eval.scenarios import leas_horizon
+        from leas_jax.steering.leas import rollout_batch
+
+        cfg = self.config
+        width = 16 * math.ceil(max(len(w) for w in waypoints) / 16)
+        padded = np.stack([np.concatenate([w, np.repeat(w[-1:], width - len(w), axis=0)]) for w in waypoints])
+        steps = max(
+            leas_horizon(
+                p[:2],
+                w,
+                self.env.target_speed,
+                self.env.timestep,
+                self.env.episode_length,
+                cfg.horizon_factor,
+            )
+            for p, w in zip(poses, waypoints)
+        )
+        steps = cfg.horizon_quantum * math.ceil(steps / cfg.horizon_quantum)
+        out = rollout_batch(
+            self.policy,
+            self.field,
+            poses,
+            padded,
+            speeds,
+            max_steps=steps,
+            stop_at_target=True,
+            stop_at_invalid=False,
+        )
+        return [out.guide(n).astype(np.float64) for n in range(len(poses))]
+
+    def _remaining_route(self, query: Query, prefix: np.ndarray) -> np.ndarray:
+        """Route points not yet passed by the guide prefix [k, 4] (in order; the goal always stays)."""
+        index = 0
+        for xy in prefix[:, :2]:
+            if index < len(query.route) - 1 and np.hypot(*(xy - query.route[index])) < self.config.via_radius:
+                index += 1
+        return query.route[index:]
+
+    # ---- the loop ------------------------------------------------------------------------
+    def run(
+        self, queries, workers: int = 0, pool=None, address: str | None = None, done=None
+    ) -> list[NavigationResult]:
+        """Answer every query (host). Generator tasks of different queries run in parallel.
+
+        Args:
+            queries: `Query` objects (see `query`).
+            workers: contact-generator processes when no `pool` is given (0: in this process).
+            pool: a `ValidationPool` of this terrain with return_plans=True, or None.
+            address: Ray address for a pool made here (None: local).
+            done: None, or a function (query index, NavigationResult) -> None called as each
+                query ends.
+
+        Returns:
+            One `NavigationResult` per query, in order.
+        """
+        from leas_jax.contacts.validation.pool import ValidationPool
+
+        if pool is None:
+            with ValidationPool(
+                self.terrain,
+                workers=workers,
+                config=self.config.generator,
+                address=address,
+                return_plans=True,
+            ) as own:
+                return self.run(queries, pool=own, done=done)
+        self._done = done or (lambda k, result: None)
+        states = [_State(q, np.zeros(self.lattice.shape[:2])) for q in queries]
+        for k, state in enumerate(states):
+            began = time.perf_counter()
+            try:
+                state.search = self._route_search(state, state.query.start, state.query.route)
+            except ValueError as exc:
+                raise UsageError(f"--start: {_fmt(state.query.start[[0, 1, 3]])}: {exc}") from None
+            state.seconds["search"] += time.perf_counter() - began
+            self._said_search(k, state)
+        began = time.perf_counter()
+        guides = self._rollout(
+            np.stack([s.query.start for s in states]),
+            np.array([s.query.speed for s in states]),
+            [s.search.waypoints for s in states],
+        )
+        share = (time.perf_counter() - began) / max(1, len(states))
+        pending = {}
+        for k, (state, guide) in enumerate(zip(states, guides)):
+            state.seconds["rollout"] += share
+            state.guide, state.segment_begin = guide, 0
+            state.path, state.waypoints = state.search.path, state.search.waypoints
+            self.say(f"query {k}: rollout {len(guide)} poses ({share:.2f} s)")
+            pending[pool.submit([guide], self.env.timestep)] = k
+        while pending:
+            done, _ = concurrent.futures.wait(list(pending), return_when=concurrent.futures.FIRST_COMPLETED)
+            for future in sorted(done, key=lambda f: pending[f]):
+                k = pending.pop(future)
+                next_guide = self._after_validation(k, states[k], future.result()[0])
+                if next_guide is not None:
+                    pending[pool.submit([next_guide], self.env.timestep)] = k
+        return [s.done for s in states]
+
+    def _said_search(self, k: int, state: _State) -> None:
+        found = state.search
+        end = (
+            "reaches the goal"
+            if found.reached
+            else f"ends {found.end_distance:.2f} m from the goal ({found.reason})"
+        )
+        self.say(
+            f"query {k}: search {found.length:.2f} m, {len(found.waypoints)} waypoints, {end} "
+            f"({state.seconds['search']:.2f} s so far)"
+        )
+
+    def _after_validation(self, k: int, state: _State, result) -> np.ndarray | None:
+        """Record the generator's answer on the state's guide; return the next guide or None (done)."""
+        from leas_jax.eval import metrics
+
+        guide, query, cfg = state.guide, state.query, self.config
+        state.seconds["contact_planning"] += float(result.seconds)
+        if state.search.reason is not None and state.unreachable is None:
+            state.unreachable = state.search.reason
+        if result.error is not None:
+            return self._finish(
+                state, reasons.GENERATOR_ERROR, f"contact generator failed: {result.error}", k
+            )
+        last, total = int(result.last_valid_index), len(guide)
+        outcome = metrics.outcome(guide, query.goal, result.coverage, last, plan=result.plan)
+        if last >= 0 and (state.best is None or outcome.final_distance < state.best[0]):
+            state.best = (outcome.final_distance, result.plan, guide)
+        # where the generator stopped (None: it covered the whole guide, the policy stopped short)
+        failure = None
+        if not outcome.success and 0 <= last < total - 1:
+            stride = getattr(cfg.generator, "stride", None) or 5
+            pose = guide[min(last + stride, total - 1)]
+            failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
+        state.attempts.append(
+            Attempt(
+                state.segment_begin,
+                total,
+                last,
+                float(result.coverage),
+                None if failure is None else (float(failure[0]), float(failure[1])),
+                state.search.reason,
+            )
+        )
+        self.say(
+            f"query {k}: contact planning covers {100 * result.coverage:.1f} % of {total} poses, "
+            f"last valid {last} ({result.seconds:.2f} s)"
+        )
+        if outcome.success:
+            return self._finish(state, reasons.REACHED, "reached the goal", k)
+        if last < 0:
+            return self._finish(
+                state,
+                reasons.NO_STANCE,
+                f"the contact generator finds no first posture at the start {_fmt(guide[0, :2])}",
+                k,
+            )
+        if last >= total - 1 and state.search.reason is not None:
+            return self._finish(state, state.search.reason, self._unreachable_text(state), k)
+        if len(state.attempts) > cfg.max_replans:
+            if state.unreachable is not None:
+                return self._finish(state, state.unreachable, self._unreachable_text(state), k)
+            where = guide[-1, :2] if failure is None else failure
+            return self._finish(
+                state,
+                reasons.REPLAN_LIMIT,
+                f"the contact generator still stops near {_fmt(where)} after {cfg.max_replans} replans",
+                k,
+            )
+        if failure is None:  # the whole guide is verified: walk on from its end
+            begin = total - 1
+        else:  # penalise the failed region, search again from a verified pose before it
+            cells = self.lattice.position(
+                np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
+            )
+            state.penalty += cfg.failure_penalty * (
+                np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
+            )
+            walked = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(guide[: last + 1, :2], axis=0).T))])
+            begin = int(np.searchsorted(walked, walked[-1] - cfg.backoff_distance, side="right")) - 1
+            begin = max(0, begin)
+        pose = guide[begin]
+        speed = (
+            float(np.hypot(*(guide[begin, :2] - guide[begin - 1, :2])) / self.env.timestep)
+            if begin > 0
+            else query.speed
+        )
+        avoid = "walking on" if failure is None else f"avoiding {_fmt(failure)}"
+        self.say(f"query {k}: replan {len(state.attempts)} from guide pose {begin} {_fmt(pose[:2])}, {avoid}")
+        began = time.perf_counter()
+        try:
+            state.search = self._route_search(state, pose, self._remaining_route(query, guide[: begin + 1]))
+        except ValueError:  # the verified pose has no valid lattice node near it: nothing to search from
+            return self._finish(
+                state,
+                reasons.REPLAN_LIMIT,
+                f"no valid lattice node near the verified pose {_fmt(pose[:2])}",
+                k,
+            )
+        state.seconds["search"] += time.perf_counter() - began
+        self._said_search(k, state)
+        began = time.perf_counter()
+        (segment,) = self._rollout(pose[None], np.array([speed]), [state.search.waypoints])
+        state.seconds["rollout"] += time.perf_counter() - began
+        state.path, state.waypoints = state.search.path, state.search.waypoints
+        state.guide = np.concatenate([guide[:begin], segment])
+        state.segment_begin = begin
+        return state.guide
+
+    def _unreachable_text(self, state: _State) -> str:
+        goal = state.query.goal
+        if state.unreachable == reasons.GOAL_INVALID:
+            return (
+                f"goal {_fmt(goal)} cannot be reached: no valid root pose within "
+                f"{self.config.search.goal_radius:g} m of it (inside an obstacle or over the void)"
+            )
+        return f"goal {_fmt(goal)} cannot be reached: no lattice path from the start leads there"
+
+    def _finish(self, state: _State, reason: str, text: str, k: int) -> None:
+        if state.best is None:
+            plan, guide, distance = None, None, float("nan")
+        else:
+            distance, plan, guide = state.best
+        if reason != reasons.REACHED:
+            ends = (
+                "no verified posture"
+                if plan is None
+                else f"the best verified plan ends {distance:.2f} m from the goal"
+            )
+            text = f"{text}; {ends}"
+        state.seconds["lattice"] = self.lattice_seconds
+        state.done = NavigationResult(
+            success=reason == reasons.REACHED,
+            reason=reason,
+            message=text,
+            plan=plan,
+            guide=guide,
+            waypoints=state.waypoints,
+            path=state.path,
+            replans=len(state.attempts) - 1,
+            attempts=tuple(state.attempts),
+            final_distance=float(distance),
+            seconds=dict(state.seconds),
+            timestep=self.env.timestep,
+        )
+        self.say(f"query {k}: {reason}: {text}")
+        self._done(k, state.done)
+        return None
+
+
+def navigate(
+    policy,
+    terrain,
+    start,
+    goal,
+    config: NavigateConfig = NavigateConfig(),
+    *,
+    speed: float = 0.0,
+    via=None,
+    workers: int = 0,
+    progress=None,
+) -> NavigationResult:
+    """A verified whole-body contact plan from a start to a goal (host; JAX and the generator inside).
+
+    Args:
+        policy: a `leas_jax.training.Policy` (`leas_jax.training.load_policy`).
+        terrain: a `leas_jax.terrain.Terrain`.
+        start: (x, y, yaw) world, m and rad (or (x, y, z, yaw); z is set on the terrain).
+        goal: (x, y) world, m.
+        config: `NavigateConfig`.
+        speed: initial speed along the heading, m/s.
+        via: optional [V, 2] points to pass, in order, before the goal.
+        workers: contact-generator processes (0: in this process).
+        progress: None or a function str -> None (one line per step).
+
+    Returns:
+        `NavigationResult`; `seconds["total"]` is the wall time of the call.
+
+    Raises:
+        UsageError: the start or goal is off the terrain, or the start pose is in collision.
+    """
+    began = time.perf_counter()
+    navigator = Navigator(policy, terrain, config, progress)
+    (result,) = navigator.run([navigator.query(start, goal, speed, via)], workers=workers)
+    result.seconds["total"] = time.perf_counter() - began
+    return result

@@ -1,0 +1,106 @@
+"""benchmarks/env_throughput.py times programs that compute what they claim.
+
+The checksum a timed program returns must equal the one of a plain Python loop
+that steps a few envs one by one and sums each step's observation, reward and
+done flag: a timed program that no longer computed the heightmap (XLA removes
+work nothing reads) or that skipped a step would fail here.
+"""
+
+import dataclasses
+import sys
+from pathlib import Path
+
+import jax
+import numpy as np
+import pytest
+
+from leas_jax.env import EnvConfig, LeasEnv, heightfield_from_terrain
+from leas_jax.env.field import sample_bilinear
+from leas_jax.env.heightmap import sample
+from leas_jax.terrain import load_terrain
+from leas_jax.training.config import resolve_data_path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+
+import env_throughput as bench  # noqa: E402
+from reference_env import ReferenceEnv, bilinear  # noqa: E402
+
+ENVS, STEPS = 3, 12
+# short episodes: the wrapper's fresh resets happen within the few steps
+CONFIG = dataclasses.replace(EnvConfig(), episode_length=5)
+
+
+@pytest.fixture(scope="module")
+def field():
+    return heightfield_from_terrain(load_terrain(resolve_data_path("terrains/training_arena.toml")), CONFIG)
+
+
+def _timed(kind, field):
+    compiled, _ = bench.compile_program(kind, field, CONFIG, ENVS, STEPS)
+    return np.asarray(compiled(field, jax.random.PRNGKey(3)), np.float64)
+
+
+def _loop(field, make_env, after_step=None):
+    """Sums over steps and envs of (obs, reward, done, heightmap part of obs), one env at a time."""
+    reset = jax.jit(lambda f, k: make_env(f).reset(k))
+    step = jax.jit(lambda f, s, a: make_env(f).step(s, a))
+    reset_keys, action_keys = bench.rollout_keys(jax.random.PRNGKey(3), ENVS, STEPS)
+    actions = [bench.step_actions(k, ENVS) for k in action_keys]
+    total = np.zeros(4)
+    for i in range(ENVS):
+        state = reset(field, reset_keys[i])
+        for t in range(STEPS):
+            state = step(field, state, actions[t][i])
+            if after_step is not None:
+                state = after_step(field, state)
+            obs = np.asarray(state.obs, np.float64)
+            total += [obs.sum(), float(state.reward), float(state.done), obs[4:].sum()]
+    return total
+
+
+@jax.jit
+def _fresh_root(field, rng):
+    env = LeasEnv(field, CONFIG)
+    root = env.random_root(rng)
+    return root, env.observe(root)
+
+
+def _fresh_start(field, state):
+    """FreshResetVmap's rule for one env: a finished episode continues from a fresh random start."""
+    if float(state.done) == 0.0:
+        return state
+    root, obs = _fresh_root(field, state.pipeline_state.rng)
+    return state.replace(pipeline_state=root, obs=obs)
+
+
+def _assert_same(timed, loop):
+    np.testing.assert_allclose(timed, loop[:3], rtol=1e-5, atol=1e-3)
+    # the test can fail: without the heightmap, the observations' sum would be far off
+    assert abs(timed[0] - (loop[0] - loop[3])) > 100 * (1e-5 * abs(loop[0]) + 1e-3)
+
+
+def test_plain_vmap_checksum_is_the_python_loops(field):
+    _assert_same(_timed("plain_vmap", field), _loop(field, lambda f: LeasEnv(f, CONFIG)))
+
+
+def test_wrapper_checksum_is_the_python_loops(field):
+    loop = _loop(field, lambda f: LeasEnv(f, CONFIG), after_step=_fresh_start)
+    assert loop[2] > 0  # some episodes ended, so fresh starts were drawn and observed
+    _assert_same(_timed("wrapper", field), loop)
+
+
+def test_reference_checksum_is_the_python_loops(field):
+    _assert_same(_timed("reference", field), _loop(field, lambda f: ReferenceEnv(f, CONFIG)))
+
+
+def test_reference_heightmap_is_the_envs(field):
+    """The reference samples the env's 77 heightmap points with the same heights."""
+    key = jax.random.PRNGKey(0)
+    lo, hi = field.origin - 0.5, field.origin + np.array(field.heights.shape) * field.resolution + 0.5
+    xy = jax.random.uniform(key, (500, 2), minval=lo, maxval=hi)  # some points off the grid
+    np.testing.assert_allclose(bilinear(field, xy), sample_bilinear(field, xy), atol=1e-5)
+    ref = ReferenceEnv(field, CONFIG)
+    state = ref.reset(key)
+    pose = np.concatenate([np.asarray(state.pos), [float(state.yaw)]])
+    assert state.obs.shape == (CONFIG.observation_size,)
+    np.testing.assert_allclose(state.obs[4:], sample(field, pose, CONFIG.heightmap), atol=1e-5)

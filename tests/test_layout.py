@@ -1,0 +1,39 @@
+"""The package's layout: no import cycles, training does not depend on evaluation."""
+
+import import_graph
+
+
+def test_no_import_cycles():
+    assert import_graph.cycles(import_graph.graph()) == []
+
+
+def test_training_imports_no_evaluation_code():
+    edges = import_graph.graph()
+    reached, pending = set(), [m for m in edges if m.startswith("leas_jax.training")]
+    while pending:
+        module = pending.pop()
+        if module not in reached:
+            reached.add(module)
+            pending.extend(edges[module])
+    assert not {m for m in reached if m.startswith("leas_jax.eval")}
+    assert "leas_jax.contacts.validation.pool" in reached  # the walk follows lazy imports
+
+
+def test_a_cycle_is_found(tmp_path):
+    """The checker on a small package: a cycle through a lazy import and a `from . import`,
+    not through a TYPE_CHECKING import nor a package's own submodule."""
+    package = tmp_path / "leas_jax"
+    (package / "sub").mkdir(parents=True)
+    (package / "__init__.py").write_text("from leas_jax import a\n")
+    (package / "a.py").write_text("def f():\n    from leas_jax.sub import b\n")
+    (package / "sub" / "__init__.py").write_text("")
+    (package / "sub" / "b.py").write_text("from .. import c\n")
+    (package / "c.py").write_text("import leas_jax.a\n")
+    (package / "d.py").write_text(
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from leas_jax import e\n"
+    )
+    (package / "e.py").write_text("from leas_jax import d\n")
+    edges = import_graph.graph(tmp_path)
+    assert edges["leas_jax.sub.b"] == {"leas_jax.c"}
+    assert edges["leas_jax.d"] == set()
+    assert import_graph.cycles(edges) == [["leas_jax.a", "leas_jax.c", "leas_jax.sub.b"]]

@@ -1,7 +1,7 @@
 """Mesh-terrain speed (issue 22): raster + support surfaces of a 20 x 20 m mesh scene, and
 the contact generator on a mesh terrain against the same terrain as boxes.
 
-  scene      terrains/hpp_random_10x10.toml: the HPP group's random_scene_10x10_V3.stl
+  scene      terrains/hpp/random_10x10.toml: the HPP group's random_scene_10x10_V3.stl
              (hpp-environments, 7 326 triangles) over 20 x 20 m at 0.02 m (1001 x 1001
              raster points): load the file, ray cast the raster, extract the support
              surfaces, each from a fresh load (no cache). Target <= 10 s.
@@ -40,7 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import save  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
-SCENE = REPO / "terrains" / "hpp_random_10x10.toml"
+SCENE = REPO / "terrains" / "hpp" / "random_10x10.toml"
 BOXES = REPO / "terrains" / "training_arena.toml"
 GUIDES = sorted((REPO / "tests" / "data").glob("*_leas_guide.npz"))
 SCENE_TARGET_S = 10.0

@@ -19,7 +19,8 @@ REPO = Path(__file__).resolve().parents[1]
 BOX_TERRAINS = sorted(p for p in (REPO / "terrains").glob("*.toml") if "[[box]]" in p.read_text()) + [
     REPO / "tests" / "data" / "slab_with_wall.toml"
 ]
-HPP_TERRAINS = sorted((REPO / "terrains").glob("hpp_*.toml"))
+# Scenes of hpp-environments, kept apart from the generated box terrains of terrains/*.toml.
+HPP_TERRAINS = sorted((REPO / "terrains" / "hpp").glob("*.toml"))
 HEAD = 'name = "m"\nbounds = [[-1.0, -1.0], [3.0, 2.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
 STEP = (
     HEAD
@@ -100,7 +101,7 @@ def test_round_trip_contact_plans(guide, tmp_path):
 def test_raster_matches_mujoco_ray_cast():
     import mujoco
 
-    terrain = load_terrain(REPO / "terrains" / "hpp_rubble.toml")
+    terrain = load_terrain(REPO / "terrains" / "hpp" / "rubble.toml")
     model = mujoco.MjModel.from_xml_string(terrain.to_mjcf())
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
@@ -362,7 +363,7 @@ def test_verified_plan_on_an_hpp_scene(tmp_path):
     from leas_jax.contacts import plan_contacts, verify
     from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT
 
-    terrain = load_terrain(REPO / "terrains" / "hpp_bridge.toml")
+    terrain = load_terrain(REPO / "terrains" / "hpp" / "bridge.toml")
     count = int(round(1.5 / 0.018)) + 1
     x = np.linspace(-2.0, -0.5, count)
     guide = np.stack([x, np.full(count, -0.65), np.full(count, NOMINAL_ROOT_HEIGHT), np.zeros(count)], axis=1)
@@ -383,7 +384,7 @@ def test_env_heightfield_and_cli_on_a_mesh_scene(tmp_path):
     from leas_jax.cli import main
     from leas_jax.env.field import heightfield_from_terrain
 
-    path = REPO / "terrains" / "hpp_stairs.toml"
+    path = REPO / "terrains" / "hpp" / "stairs.toml"
     field = heightfield_from_terrain(load_terrain(path))
     spawn = np.asarray(field.spawn_xy)
     assert len(spawn) > 100

@@ -149,7 +149,10 @@ def terrain_figure(terrain):
         draw_scenario(axes, terrain.scenario)
     axes.set_xlabel("x (m)")
     axes.set_ylabel("y (m)")
-    parts = [f"{len(terrain.boxes)} boxes"] + ([f"{len(terrain.meshes)} meshes"] if terrain.meshes else [])
+    meshes = len(terrain.meshes)
+    parts = [f"{len(terrain.boxes)} boxes"] + (
+        [f"{meshes} mesh{'es' if meshes > 1 else ''}"] if meshes else []
+    )
     axes.set_title(f"{terrain.name}: {', '.join(parts)}, resolution {terrain.resolution:g} m")
     return figure
 

@@ -12,11 +12,16 @@ the contact generator on a mesh terrain against the same terrain as boxes.
              the terrain's STL export loaded as a `[[mesh]]` terrain; CPU ms per
              footstep (single-support posture) of each. Target: mesh <= 2 x boxes.
 
+  elevation  (--elevation-samples N, off by default) an N x N elevation map of
+             0.1 sin(3x) cos(2y) at 0.02 m: load, raster, support surfaces and the
+             generator's surface arrays (`surface_arrays`), CPU s each. A curved map
+             gives one support polygon per triangle: this shows where that stops scaling.
+
 Times are the process's CPU time (`time.process_time`, wall time saved too); BLAS pools
 are limited to one thread; the load average is saved before and after. Writes
 results/terrain_raster_speed.json.
 
-    python benchmarks/terrain_raster_speed.py [--runs 3] [--guide-runs 2]
+    python benchmarks/terrain_raster_speed.py [--runs 3] [--guide-runs 2] [--elevation-samples 150]
 """
 
 from __future__ import annotations
@@ -79,6 +84,35 @@ def scene_case(path: Path, runs: int) -> dict:
     }
 
 
+def elevation_case(samples: int, folder: Path) -> dict:
+    """CPU seconds of load, raster, support surfaces and surface arrays of an N x N elevation map."""
+    from leas_jax.contacts.planner.surfaces import surface_arrays
+    from leas_jax.terrain import load_terrain
+
+    res = 0.02
+    x = np.arange(samples) * res
+    np.save(folder / "elevation.npy", 0.1 * np.sin(3 * x[:, None]) * np.cos(2 * x[None, :]))
+    side = (samples - 1) * res
+    (folder / "elevation.toml").write_text(
+        f'name = "elevation"\nbounds = [[0.0, 0.0], [{side}, {side}]]\nvoid_height = -2.0\n'
+        f'resolution = {res}\n[elevation]\nfile = "elevation.npy"\norigin = [0.0, 0.0, 0.0]\n'
+        f"resolution = {res}\n"
+    )
+    load_s, _, terrain = _timed(lambda: load_terrain(folder / "elevation.toml"))
+    raster_s, _, _ = _timed(terrain.raster)
+    surfaces_s, _, surfaces = _timed(terrain.support_surfaces)
+    arrays_s, _, _ = _timed(lambda: surface_arrays(terrain, 0.5))
+    return {
+        "samples": samples,
+        "triangles": int(len(terrain.meshes[0].faces)),
+        "support_surfaces": len(surfaces),
+        "load_cpu_s": load_s,
+        "raster_cpu_s": raster_s,
+        "support_surfaces_cpu_s": surfaces_s,
+        "surface_arrays_cpu_s": arrays_s,
+    }
+
+
 def mesh_twin(terrain, folder: Path):
     """The terrain's boxes exported to STL and loaded back as a one-mesh terrain."""
     from leas_jax.terrain import loads_terrain
@@ -129,6 +163,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3, help="timed repeats of the scene case")
     parser.add_argument("--guide-runs", type=int, default=2, help="timed repeats of each guide")
+    parser.add_argument(
+        "--elevation-samples", type=int, default=0, help="N of an N x N elevation case (0: skip)"
+    )
     args = parser.parse_args(argv)
     load_before = os.getloadavg()[0]
     scene = scene_case(SCENE, args.runs)
@@ -136,6 +173,9 @@ def main(argv=None) -> int:
     print(f"scene {scene['best_cpu_s']:.2f} s (boxes reference {reference['best_cpu_s']:.2f} s)")
     with tempfile.TemporaryDirectory() as folder:
         guides = [generator_case(g, args.guide_runs, Path(folder)) for g in GUIDES]
+        elevation = elevation_case(args.elevation_samples, Path(folder)) if args.elevation_samples else None
+    if elevation:
+        print(f"elevation {elevation}")
     for g in guides:
         print(
             f"{g['guide']}: {g['boxes']['best_ms_per_footstep']:.2f} ms/step boxes, "
@@ -155,6 +195,7 @@ def main(argv=None) -> int:
             "generator_worst_ratio": worst,
             "generator_target_ratio": GENERATOR_TARGET_RATIO,
             "generator_within_target": worst <= GENERATOR_TARGET_RATIO,
+            "elevation": elevation,
             "load_average_before": load_before,
             "load_average_after": os.getloadavg()[0],
         },

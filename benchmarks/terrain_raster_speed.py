@@ -19,7 +19,7 @@ the contact generator on a mesh terrain against the same terrain as boxes.
 
 Times are the process's CPU time (`time.process_time`, wall time saved too); BLAS pools
 are limited to one thread; the load average is saved before and after. Writes
-results/terrain_raster_speed.json.
+<--out>/terrain_raster_speed.json (default benchmarks/results).
 
     python benchmarks/terrain_raster_speed.py [--runs 3] [--guide-runs 2] [--elevation-samples 150]
 """
@@ -42,7 +42,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import save  # noqa: E402
+from common import add_out_argument, load_average, save  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "terrains" / "hpp" / "random_10x10.toml"
@@ -163,11 +163,12 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3, help="timed repeats of the scene case")
     parser.add_argument("--guide-runs", type=int, default=2, help="timed repeats of each guide")
+    add_out_argument(parser)
     parser.add_argument(
         "--elevation-samples", type=int, default=0, help="N of an N x N elevation case (0: skip)"
     )
     args = parser.parse_args(argv)
-    load_before = os.getloadavg()[0]
+    load_before = load_average()
     scene = scene_case(SCENE, args.runs)
     reference = scene_case(BOXES, args.runs)
     print(f"scene {scene['best_cpu_s']:.2f} s (boxes reference {reference['best_cpu_s']:.2f} s)")
@@ -196,9 +197,9 @@ def main(argv=None) -> int:
             "generator_target_ratio": GENERATOR_TARGET_RATIO,
             "generator_within_target": worst <= GENERATOR_TARGET_RATIO,
             "elevation": elevation,
-            "load_average_before": load_before,
-            "load_average_after": os.getloadavg()[0],
         },
+        load_before,
+        out=args.out,
     )
     return 0
 

@@ -82,6 +82,18 @@ def machine() -> dict:
     }
 
 
+def provenance(load_before: dict) -> dict:
+    """What every benchmark record carries: the time, the machine, the git state when the
+    benchmark started, and the load average before (`load_before`) and after (now)."""
+    return {
+        "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "machine": machine(),
+        "git": GIT_AT_START,
+        "load_average_before": load_before,
+        "load_average_after": load_average(),
+    }
+
+
 def add_out_argument(parser: argparse.ArgumentParser) -> None:
     """The `--out DIR` option every benchmark takes (default benchmarks/results/)."""
     parser.add_argument(
@@ -98,18 +110,9 @@ def save(name: str, payload: dict, load_before: dict, out: Path = RESULTS) -> Pa
         load_before: `load_average()` read before the measurement started.
         out: folder (created if missing).
 
-    The file holds the payload with the benchmark's name, the time, the machine, the
-    git state when the benchmark started, and the load average before and after (now).
+    The file holds the benchmark's name, its `provenance` and the payload.
     """
-    record = {
-        "benchmark": name,
-        "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        "machine": machine(),
-        "git": GIT_AT_START,
-        "load_average_before": load_before,
-        "load_average_after": load_average(),
-        **payload,
-    }
+    record = {"benchmark": name, **provenance(load_before), **payload}
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"{name}.json"

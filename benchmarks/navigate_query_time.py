@@ -10,18 +10,17 @@ straight 10 m guide (`plan_contacts`), so that loaded-machine figures can be sca
 
     python benchmarks/navigate_query_time.py [--queries 20] [--seed 0]
 
-Writes results/navigate_query_time.json.
+Writes <out>/navigate_query_time.json.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import os
 import time
 
 import numpy as np
-from common import save
+from common import add_out_argument, load_average, save
 
 PARTS = ("search", "rollout", "contact_planning")
 
@@ -30,6 +29,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--queries", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
+    add_out_argument(parser)
     args = parser.parse_args()
 
     from leas_jax.contacts import plan_contacts
@@ -38,7 +38,7 @@ def main() -> None:
     from leas_jax.terrain import load_terrain
     from leas_jax.training import load_policy
 
-    load_before = os.getloadavg()
+    load_before = load_average()
     policy = load_policy("checkpoints/leas_talos")
     terrain = load_terrain("terrains/eval_ground.toml")
     rng = np.random.default_rng(args.seed)
@@ -86,7 +86,6 @@ def main() -> None:
     report = {
         "queries": args.queries,
         "seed": args.seed,
-        "load_average_before": load_before,
         "lattice_s": lattice_s,
         "warm_up_query_s": warm_s,
         "reference_plan_contacts_10m_s": reference,
@@ -96,10 +95,9 @@ def main() -> None:
         "success": int(sum(r["success"] for r in rows)),
         "replans": int(sum(r["replans"] for r in rows)),
         "rows": rows,
-        "load_average_after": os.getloadavg(),
     }
     print({k: v for k, v in report.items() if k != "rows"})
-    save("navigate_query_time", report)
+    save("navigate_query_time", report, load_before, args.out)
 
 
 if __name__ == "__main__":

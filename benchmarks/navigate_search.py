@@ -11,18 +11,17 @@ generator makes of the paths is `leas evaluate --methods ...,navigate`'s questio
 
     python benchmarks/navigate_search.py [--scenarios bridge hole] [--n-starts 60] [--rrt-starts N]
 
-Writes results/navigate_search.json.
+Writes <out>/navigate_search.json.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import os
 import time
 
 import numpy as np
-from common import save
+from common import add_out_argument, load_average, save
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -52,6 +51,7 @@ def main() -> None:
     parser.add_argument("--scenarios", nargs="+", default=["bridge", "hole"])
     parser.add_argument("--n-starts", type=int, default=60)
     parser.add_argument("--rrt-starts", type=int, default=None, help="RRT on the first N starts only")
+    add_out_argument(parser)
     args = parser.parse_args()
 
     from leas_jax.env import heightfield_from_terrain
@@ -66,8 +66,8 @@ def main() -> None:
     policy = load_policy("checkpoints/leas_talos")
     env = policy.config.env
     config = BaselineConfig.from_env(env)
-    load_before = os.getloadavg()
-    report = {"load_average_before": load_before, "scenarios": {}}
+    load_before = load_average()
+    report = {"scenarios": {}}
     for name in args.scenarios:
         terrain = load_terrain(scenario_file(name))
         scenario = terrain.scenario
@@ -118,8 +118,7 @@ def main() -> None:
             "rrt_over_lattice_median_time": rrt["median_s"] / lat_same["median_s"],
         }
         print(name, report["scenarios"][name], flush=True)
-    report["load_average_after"] = os.getloadavg()
-    save("navigate_search", report)
+    save("navigate_search", report, load_before, args.out)
 
 
 if __name__ == "__main__":

@@ -50,7 +50,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import machine  # noqa: E402
+from common import load_average, provenance  # noqa: E402
 from reachability_validation import wilson  # noqa: E402
 
 from leas_jax.errors import UsageError  # noqa: E402
@@ -310,7 +310,7 @@ def main(argv=None) -> None:
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.terrain import load_terrain
 
-    load_before = machine()["load_average_1min"]
+    load_before = load_average()
     began = time.perf_counter()
     terrain = load_terrain(scenario_file("ground"))
     env = EnvConfig()
@@ -407,8 +407,7 @@ def main(argv=None) -> None:
     ]
     report["turn_separation"] = {v: turn_separation(report["trajectories"], v) for v in described}
     report["seconds"] = {"guides": built - began, "contact_planning": validated - built}
-    report["machine"] = {**machine(), "load_average_1min_before": load_before}
-    report["time"] = time.strftime("%Y-%m-%dT%H:%M:%S")
+    report.update(provenance(load_before))
 
     import json
 

@@ -260,14 +260,18 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--time-limit", type=float, default=20.0, help="seconds per mutant (default 20)")
     parser.add_argument(
-        "--out", type=Path, default=None, help="JSON file (default benchmarks/results/terrain_fuzz.json)"
+        "--out",
+        type=Path,
+        default=None,
+        help="JSON file, ending in .json (default benchmarks/results/terrain_fuzz.json)",
     )
     args = parser.parse_args(argv)
-    from common import machine, save
+    if args.out is not None and args.out.suffix != ".json":
+        parser.error(f"--out {args.out}: give a file name ending in .json")
+    from common import RESULTS, load_average, save
 
-    load_before = machine()["load_average_1min"]
+    load_before = load_average()
     report = fuzz(args.mutants, args.seed, args.time_limit)
-    report["load_average_before"] = load_before
     print(
         json.dumps(
             {
@@ -276,14 +280,8 @@ def main(argv=None) -> int:
             }
         )
     )
-    if args.out is None:
-        save("terrain_fuzz", report)
-    else:
-        from common import machine as describe
-
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps({**report, "machine": describe()}, indent=2) + "\n")
-        print(f"wrote {args.out}")
+    out = RESULTS / "terrain_fuzz.json" if args.out is None else args.out
+    save(out.stem, report, load_before, out.parent)
     return 1 if report["non_terrain_errors"] or report["hangs"] else 0
 
 

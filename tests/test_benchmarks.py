@@ -7,6 +7,7 @@ work nothing reads) or that skipped a step would fail here.
 """
 
 import dataclasses
+import json
 import sys
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from leas_jax.training.config import resolve_data_path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 
+import common  # noqa: E402
 import env_throughput as bench  # noqa: E402
 from reference_env import ReferenceEnv, bilinear  # noqa: E402
 
@@ -104,3 +106,14 @@ def test_reference_heightmap_is_the_envs(field):
     pose = np.concatenate([np.asarray(state.pos), [float(state.yaw)]])
     assert state.obs.shape == (CONFIG.observation_size,)
     np.testing.assert_allclose(state.obs[4:], sample(field, pose, CONFIG.heightmap), atol=1e-5)
+
+
+def test_save_records_machine_load_and_commit(tmp_path):
+    path = common.save("probe", {"figure": 1.5}, common.load_average(), tmp_path / "out")
+    record = json.loads(path.read_text())
+    assert path == tmp_path / "out" / "probe.json" and record["figure"] == 1.5
+    assert record["machine"]["cores"] >= 1 and record["machine"]["backend"] == jax.default_backend()
+    for key in ("load_average_before", "load_average_after"):
+        assert set(record[key]) == {"1min", "5min", "15min"}
+    assert len(record["git"]["commit"]) == 40 and isinstance(record["git"]["dirty"], bool)
+    assert not list(path.parent.glob("*.partial"))

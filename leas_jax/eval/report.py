@@ -237,13 +237,13 @@ def write_report(
     """Evaluate a `leas run` directory and write report.md, eval.json and PNGs into it.
 
     `out` holds `geometric/` (and, after planner fine-tuning, `planner/`), or
-    is itself a single run directory (with `policy.pkl`).
+    is itself a single run directory (with `policy.ckpt`).
 
     Host function (loads files, runs jitted rollouts and contact planning, writes files).
     """
     out = Path(out)
     geometric = out / "geometric" if (out / "geometric").is_dir() else out
-    planner = out / "planner" if (out / "planner" / "policy.pkl").exists() else None
+    planner = out / "planner" if (out / "planner" / "policy.ckpt").exists() else None
     lines = [f"# LeaS run `{out.name}`", ""]
     section, results = _geometric_section(geometric, out, n_episodes)
     lines += section

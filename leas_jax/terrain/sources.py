@@ -219,7 +219,17 @@ def _mesh(check, key: str, raw: dict, base: Path, expected: str | None) -> Terra
     data, digest = _read(check, f"{key}.file", name, file, expected)
     vertices, faces = _parse_mesh(check, f"{key}.file", name, file, data)
     world = translate + (vertices * scale) @ rotation_from_rpy(rpy).T
+    _check_extent(check, f"{key}.file", name, world)
     return TerrainMesh(key=key, vertices=world, faces=faces, sha256=digest, source=name)
+
+
+def _check_extent(check, key: str, name: str, world: np.ndarray) -> None:
+    """World vertices within the loader's coordinate bound (as boxes and heights are)."""
+    from leas_jax.terrain.loader import MAX_COORDINATE  # the loader imports this module
+
+    reach = float(np.abs(world).max())
+    if reach > MAX_COORDINATE:
+        check.fail(key, name, f"world vertices reach |coordinate| = {reach:g} m, beyond {MAX_COORDINATE:g} m")
 
 
 def _parse_mesh(check, key: str, name: str, file: Path, data: bytes) -> tuple[np.ndarray, np.ndarray]:
@@ -264,9 +274,11 @@ def _elevation(check, raw: dict, base: Path, expected: str | None) -> TerrainMes
     data, digest = _read(check, f"{key}.file", name, file, expected)
     grid = _parse_grid(check, f"{key}.file", name, file, data)
     heights = origin[2] + scale * grid
+    vertices = grid_vertices(heights, origin[:2], resolution)
+    _check_extent(check, f"{key}.file", name, vertices)
     return TerrainMesh(
         key=key,
-        vertices=grid_vertices(heights, origin[:2], resolution),
+        vertices=vertices,
         faces=grid_faces(*heights.shape),
         sha256=digest,
         source=name,

@@ -28,8 +28,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 # A vertical line exactly on a triangle edge meets the triangle (closed sets, as boxes):
 # edge functions may be this far (m) negative; far below the raster resolution.
@@ -392,6 +390,9 @@ def _coplanar_groups(corners: np.ndarray, normals: np.ndarray, positions: np.nda
     edges, owner = edges[order], owner[order]
     same = np.all(edges[1:] == edges[:-1], axis=1)
     a, b = owner[:-1][same], owner[1:][same]
+    from scipy.sparse import coo_matrix  # here: `leas --help` must not load SciPy
+    from scipy.sparse.csgraph import connected_components
+
     # Neighbours share an edge, so their planes meet there: the angle decides.
     ok = np.einsum("ni,ni->n", normals[a], normals[b]) >= math.cos(COPLANAR_ANGLE)
     graph = coo_matrix((np.ones(int(ok.sum())), (a[ok], b[ok])), shape=(count, count))

@@ -299,7 +299,10 @@ def test_bad_mesh_inputs(tmp_path, monkeypatch):
         assert __import__("re").search(pattern, message), message
     huge = _stl([[0, 0, 0], [2, 0, 0], [0, 1, 0]], [[0, 1, 2]])
     message = _bad(tmp_path, '[[mesh]]\nfile = "huge.stl"\nscale = 9000.0\n', {"huge.stl": huge})
-    assert "world vertices reach |coordinate| = 18000 m, beyond 10000 m" in message
+    assert (
+        'mesh[0].file ("huge.stl") largest world |coordinate| = 18000.0: must lie in [-10000, 10000]'
+        in message
+    )
     monkeypatch.setattr(terrain_sources, "MAX_TRIANGLES", 1)
     big = _stl([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], [[0, 1, 2], [1, 3, 2]])
     message = _bad(tmp_path, '[[mesh]]\nfile = "big.stl"\n', {"big.stl": big})

@@ -224,12 +224,9 @@ def _mesh(check, key: str, raw: dict, base: Path, expected: str | None) -> Terra
 
 
 def _check_extent(check, key: str, name: str, world: np.ndarray) -> None:
-    """World vertices within the loader's coordinate bound (as boxes and heights are)."""
-    from leas_jax.terrain.loader import MAX_COORDINATE  # the loader imports this module
-
-    reach = float(np.abs(world).max())
-    if reach > MAX_COORDINATE:
-        check.fail(key, name, f"world vertices reach |coordinate| = {reach:g} m, beyond {MAX_COORDINATE:g} m")
+    """World vertices within the loader's coordinate bound (`check.number`'s default range,
+    as for boxes and heights); the message names the file's key, the file and the reach."""
+    check.number(f"{key} ({json.dumps(name)}) largest world |coordinate|", float(np.abs(world).max()))
 
 
 def _parse_mesh(check, key: str, name: str, file: Path, data: bytes) -> tuple[np.ndarray, np.ndarray]:

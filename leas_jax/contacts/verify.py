@@ -87,7 +87,9 @@ def verify(plan, terrain=None) -> VerificationReport:
     Args:
         plan: a ContactPlan (e.g. `ContactPlan.load(path)`).
         terrain: the Terrain to check against; None (default) rebuilds it from
-            `plan.terrain` (the terrain file text saved with the plan).
+            `plan.terrain` (the terrain file text saved with the plan; for meshes the
+            loader reads the files again and rejects any whose SHA-256 changed).
+            A given terrain's meshes must have the SHA-256 the plan's text records.
 
     Returns:
         VerificationReport listing each (posture, check, message) that fails.
@@ -98,9 +100,11 @@ def verify(plan, terrain=None) -> VerificationReport:
     from leas_jax.contacts.robot.equilibrium import HppEquilibrium, sole_corners
     from leas_jax.contacts.robot.model import load_talos
     from leas_jax.terrain import loads_terrain
+    from leas_jax.terrain.sources import mesh_hash_mismatches
 
     if terrain is None:
         terrain = loads_terrain(plan.terrain, source="<plan terrain>")
+    mesh_mismatches = mesh_hash_mismatches(plan.terrain, terrain)
     talos = load_talos()
     robot = robot_collision(talos)
     objects = terrain_collision(terrain)
@@ -115,6 +119,7 @@ def verify(plan, terrain=None) -> VerificationReport:
     fail = report.failures
 
     # 0. plan consistency
+    fail.extend((-1, 0, message) for message in mesh_mismatches)
     if len(q_all) and (np.any(guide_index < 0) or np.any(guide_index >= len(guide))):
         fail.append((-1, 0, f"guide_index outside [0, {len(guide) - 1}]"))
     if np.any(np.diff(guide_index) < 0):

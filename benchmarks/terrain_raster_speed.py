@@ -1,4 +1,4 @@
-"""Mesh-terrain speed (issue 22): raster + support surfaces of a 20 x 20 m mesh scene, and
+"""Mesh-terrain speed: raster + support surfaces of a 20 x 20 m mesh scene, and
 the contact generator on a mesh terrain against the same terrain as boxes.
 
   scene      terrains/hpp/random_10x10.toml: the HPP group's random_scene_10x10_V3.stl

@@ -1,4 +1,4 @@
-"""Terrain format v2: meshes and elevation maps as terrains (issue 22).
+"""Terrain format v2: meshes and elevation maps as terrains.
 
 Round trip of every committed box terrain through STL, parity with MuJoCo's ray cast,
 mesh defects, an elevation map of a known function, the bad inputs, exports and the

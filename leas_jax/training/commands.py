@@ -72,8 +72,7 @@ def add_training_arguments(parser) -> None:
         help="condition the policy trains with (both phases): presets (the default: "
         "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
         "lookahead legs, foothold and gripper disks, 95.5 / 90.2 %% sensitivity / specificity "
-        'against the walking generator on fresh poses; the README\'s "Contact generator" '
-        "gives the trade)",
+        "against the walking generator on fresh poses; docs/results/INDEX.md gives the trade)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(

@@ -1,4 +1,4 @@
-"""Contact-planner speed on one core: ms per 4 m path and per footstep (issue 3).
+"""Contact-planner speed on one core: ms per 4 m path and per footstep.
 
 Three guides, built here, at 0.18 m/s with a 0.1 s timestep (paper Table I, §IV),
 root NOMINAL_ROOT_HEIGHT above the ground:

@@ -28,7 +28,7 @@ trunk cylinder is free iff the terrain under it stays below its bottom. The old 
 the chosen defaults are also evaluated with `reachability.valid` itself on
 `heightfield_from_terrain(terrain, EnvConfig(reachability=cfg))`, and must agree.
 
-Optional terms (issue 3 item 6, benchmarks/reachability_false_positives.py): a second
+Optional terms (benchmarks/reachability_false_positives.py): a second
 search (`TERMS_GRID`) adds the lookahead leg cylinders (`leg_forward`) and the foothold
 flatness term (`foothold_radius`, `foothold_search`, `foothold_spread`) of
 `leas_jax.env.reachability` to the thresholds above, on fewer radii (they cost a
@@ -47,7 +47,7 @@ largest Youden index. Near-ties go to the closest to the old defaults. Figures a
 reported on the held-out third and on all poses. Writes <out>/reachability_calibration.json
 (and caches the ground truth in .cache/reachability_ground_truth_<truth>_seed<seed>_<poses>.npz
 at the repository root, reused with --reuse when the poses and the fingerprint of the
-contact generator's sources, leas_jax/contacts/*.py, match).
+contact generator's sources, leas_jax/contacts/**/*.py, match).
 
 Default: 48 000 poses (the walking truth's held-out third then holds ~4 400 feasible
 poses, +-0.6 % on a sensitivity at 95 %; with the 12 000 used before commit 797a783,
@@ -88,7 +88,7 @@ TARGET_SENSITIVITY = 0.95
 TARGET_SPECIFICITY = 0.90
 
 # Grid of the search (m). trunk_top is not searched: no effect on a heightfield. leg_top goes
-# down to -0.95 (it stopped at -0.70 before issue 3 item 6): with the walking truth the
+# down to -0.95 (it stopped at -0.70 before the optional terms): with the walking truth the
 # lowest ground under a leg must be ~0.9 m below the root, and -0.95 still keeps the
 # flat-ground margins (FLAT_MARGIN).
 GRID = {
@@ -236,11 +236,12 @@ def ground_truth(
 
 
 def generator_fingerprint(truth: str) -> str:
-    """sha256 of the contact generator's sources (leas_jax/contacts/*.py) and of the truth's
+    """sha256 of the contact generator's sources (leas_jax/contacts/**/*.py) and of the truth's
     settings: a cached ground truth is reused only if nothing it depends on changed."""
     digest = hashlib.sha256(f"{truth} {WALK_POSES} {WALK_SPEED} {WALK_TIMESTEP}".encode())
-    for path in sorted((REPO / "leas_jax" / "contacts").glob("*.py")):
-        digest.update(path.name.encode())
+    contacts = REPO / "leas_jax" / "contacts"
+    for path in sorted(contacts.rglob("*.py")):
+        digest.update(path.relative_to(contacts).as_posix().encode())
         digest.update(path.read_bytes())
     return digest.hexdigest()
 
@@ -687,7 +688,7 @@ def main(argv=None) -> None:
         "--truth",
         choices=("static", "walking"),
         default="static",
-        help="feasible = a double-support posture (static, the issue's definition) or a plan "
+        help="feasible = a double-support posture (static) or a plan "
         "covering a 0.36 m straight guide from the pose (walking)",
     )
     parser.add_argument(

@@ -1,4 +1,4 @@
-"""False positives of the reachability condition against the contact generator (issue 3 item 6).
+"""False positives of the reachability condition against the contact generator.
 
 The poses, ground truth and condition are those of benchmarks/reachability_calibration.py
 (same seed, same cache in .cache/, `--truth walking` by default: feasible = the generator

@@ -10,7 +10,7 @@ ground truth there (cached in .cache/ like the calibration's), and reports:
    `ReachabilityConfig()` defaults, of the training presets' `TRAINING_REACHABILITY`
    and, with `--calibration-json`, of the best setting of that calibration run
    (`chosen_with_hands`), under each truth of `--truth` (static: a balanced
-   double-support posture, the issue's definition; walking: a plan covering a 0.36 m
+   double-support posture; walking: a plan covering a 0.36 m
    straight guide).
 2. **Learned reference** (`--learned`, needs scikit-learn: `pip install -e '.[dev]'`):
    what a flexible classifier reading the same local terrain reaches. A gradient-boosted

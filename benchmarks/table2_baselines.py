@@ -74,9 +74,7 @@ def parse_list(text: str, kind, name: str) -> list:
 
 
 def bootstrap_mean(values: np.ndarray, seed: int = 0) -> tuple[float, float]:
-    """95 % percentile-bootstrap interval of the mean of `values` [N]; (nan, nan) if empty."""
-    if len(values) == 0:
-        return math.nan, math.nan
+    """95 % percentile-bootstrap interval of the mean of `values` [N >= 1]."""
     rng = np.random.default_rng(seed)
     means = rng.choice(values, (BOOTSTRAP, len(values))).mean(axis=1)
     return float(np.percentile(means, 2.5)), float(np.percentile(means, 97.5))
@@ -94,8 +92,14 @@ def max_turn_deg(guide: np.ndarray) -> float:
     return float(np.degrees(np.abs(guide[k:, 3] - guide[: len(guide) - k, 3])).max()) if k else 0.0
 
 
+def percent_interval(successes: int, trials: int) -> list[float]:
+    """Wilson 95 % interval in %, clipped to [0, 100] (the bounds of 0 or n successes round past them)."""
+    return [min(100.0, max(0.0, 100.0 * x)) for x in wilson(successes, trials)]
+
+
 def summarize(trajectories) -> dict:
-    """n, mean coverage (%) and its interval, fully covered and success rates (%) with Wilson intervals."""
+    """n >= 1 trajectories -> n, mean coverage (%) and its interval, fully covered and success
+    rates (%) with Wilson intervals."""
     cover = np.array([t.outcome.coverage for t in trajectories], np.float64)
     full = int(sum(t.outcome.last_valid_index >= len(t.guide) - 1 for t in trajectories))
     success = int(sum(t.outcome.success for t in trajectories))
@@ -103,12 +107,12 @@ def summarize(trajectories) -> dict:
     lo, hi = bootstrap_mean(cover)
     return {
         "n": n,
-        "coverage": 100.0 * float(cover.mean()) if n else math.nan,
+        "coverage": 100.0 * float(cover.mean()),
         "coverage_95ci": [100.0 * lo, 100.0 * hi],
-        "fully_covered": 100.0 * full / n if n else math.nan,
-        "fully_covered_95ci": [100.0 * x for x in wilson(full, n)],
-        "success": 100.0 * success / n if n else math.nan,
-        "success_95ci": [100.0 * x for x in wilson(success, n)],
+        "fully_covered": 100.0 * full / n,
+        "fully_covered_95ci": percent_interval(full, n),
+        "success": 100.0 * success / n,
+        "success_95ci": percent_interval(success, n),
         "errors": int(sum(t.outcome.error is not None for t in trajectories)),
     }
 
@@ -118,14 +122,14 @@ def turn_separation(records: list[dict], variant: str) -> dict:
     guides covered under half: `separated` when every covered one turns less than every failed one."""
     full = [t["max_turn_deg"] for t in records if t["variant"] == variant and t["coverage"] >= 1.0]
     failed = [t["max_turn_deg"] for t in records if t["variant"] == variant and t["coverage"] < 0.5]
-    covered_max = max(full) if full else math.nan
-    failed_min = min(failed) if failed else math.nan
+    covered_max = max(full) if full else None
+    failed_min = min(failed) if failed else None
     return {
         "covered_max": covered_max,
         "failed_min": failed_min,
         "n_covered": len(full),
         "n_failed": len(failed),
-        "separated": bool(full and failed and covered_max < failed_min),
+        "separated": bool(full and failed and covered_max < failed_min),  # None above: no such guide
     }
 
 
@@ -414,7 +418,9 @@ def main(argv=None) -> None:
     from leas_jax.training.checkpoint import atomic_write_text
 
     args.out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(args.out / "table2_baselines.json", json.dumps(report, indent=1) + "\n")
+    atomic_write_text(
+        args.out / "table2_baselines.json", json.dumps(report, indent=1, allow_nan=False) + "\n"
+    )
     figure(report, args.out / "table2_baselines.png")
     for v in described:
         print(v, report["turn_separation"][v])

@@ -149,7 +149,11 @@ def terrain_figure(terrain):
         draw_scenario(axes, terrain.scenario)
     axes.set_xlabel("x (m)")
     axes.set_ylabel("y (m)")
-    axes.set_title(f"{terrain.name}: {len(terrain.boxes)} boxes, resolution {terrain.resolution:g} m")
+    meshes = len(terrain.meshes)
+    parts = [f"{len(terrain.boxes)} boxes"] + (
+        [f"{meshes} mesh{'es' if meshes > 1 else ''}"] if meshes else []
+    )
+    axes.set_title(f"{terrain.name}: {', '.join(parts)}, resolution {terrain.resolution:g} m")
     return figure
 
 

@@ -1,13 +1,71 @@
-"""Shared fixtures."""
+"""Shared fixtures, and the test tiers.
+
+`make test` runs the fast tier (`-m 'not slow'`, pyproject.toml), which must stay under 10
+minutes on 2 cores, lint included; `make test-slow` runs the rest. A test is slow when it is
+marked `@pytest.mark.slow` in its file, or listed in `SLOW_TIER` here: tests that only run
+again, on more inputs, what a fast test already checks (their assertions all still run in
+the slow tier). `make test` lists the 30 slowest tests after each run.
+
+The processes of a test run (pytest's, CLI subprocesses, notebook kernels) share one JAX
+compilation cache, made for the run and removed after it: many tests train or roll out
+the same tiny configs, and a program compiled once loads from the cache in the next test
+(benchmarks/compile_cache.py: identical `train` calls after the first took 0.089 of their
+time without it, docs/results/2026-12-01-test-compile-cache).
+A JAX_COMPILATION_CACHE_DIR set by the caller is used as it is and kept.
+"""
+
+import os
+import shutil
+import sys
+import tempfile
 
 import pytest
 
-from leas_jax.training import preset, train
+_CACHE_ENV = "JAX_COMPILATION_CACHE_DIR"
+_CACHE_KEY = pytest.StashKey[str]()
+
+# node id -> why it is in the slow tier (what the fast tier keeps of it)
+_SMOKE = "tests/test_env_leas.py::test_smoke_jit_vmap_1024_envs"
+SLOW_TIER = {
+    f"{_SMOKE}[{name}]": "the same jitted reset and step on another raster; the fast tier keeps "
+    "the training arena's, and tests/test_terrain_*.py load this terrain"
+    for name in ("eval_bridge", "eval_circuit", "eval_ground", "eval_hole", "eval_stairs", "eval_stairs_side")
+}
+
+
+def pytest_configure(config):
+    """Give the test run its compilation cache (JAX reads the variable when it is imported;
+    subprocesses inherit it)."""
+    if os.environ.get(_CACHE_ENV):
+        return
+    path = tempfile.mkdtemp(prefix="leas-jax-compile-cache-")
+    os.environ[_CACHE_ENV] = path
+    config.stash[_CACHE_KEY] = path
+    if "jax" in sys.modules:  # imported already (by a plugin): tell it too
+        sys.modules["jax"].config.update("jax_compilation_cache_dir", path)
+
+
+def pytest_unconfigure(config):
+    path = config.stash.get(_CACHE_KEY, None)
+    if path is not None:
+        os.environ.pop(_CACHE_ENV, None)
+        shutil.rmtree(path, ignore_errors=True)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Mark the `SLOW_TIER` tests slow, before `-m` selects (tests/test_layout.py checks that
+    every listed id exists)."""
+    for item in items:
+        if item.nodeid in SLOW_TIER:
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.fixture(scope="session")
 def run_dir(tmp_path_factory):
     """A tiny policy trained on the real arena (a few seconds), shared by the tests that need one."""
+    from leas_jax.training import preset, train
+
     out = tmp_path_factory.mktemp("run")
     config = preset(
         "smoke",

@@ -1,4 +1,4 @@
-"""The public Python API of the foundation issue, end to end on the real arena."""
+"""The public Python API, end to end on the real arena."""
 
 import numpy as np
 

@@ -104,7 +104,7 @@ def test_arena_check_writes_its_outputs(run_dir, tmp_path, capsys):
             "--seeds: expected comma-separated",
         ),
         (["arena-check", "--checkpoint", "nowhere", "--seeds", "-1", "--out", "o"], "integers >= 0"),
-        (["arena-check", "--checkpoint", "nowhere", "--out", "o"], "nowhere: no policy.pkl found"),
+        (["arena-check", "--checkpoint", "nowhere", "--out", "o"], "nowhere: no policy.ckpt found"),
         (
             ["arena-check", "--checkpoint", "nowhere", "--terrain", "missing.toml", "--out", "o"],
             "--terrain: no such file",

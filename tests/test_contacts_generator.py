@@ -118,7 +118,7 @@ def test_wall_stops_before_it():
 
 
 def test_narrow_bridge_crossed_on_its_centre_line():
-    """A 0.30 m bridge (the narrowest of the issue's 0.30-0.45 m): two soles side by side just fit."""
+    """A 0.30 m bridge (the narrowest of the paper's 0.30-0.45 m): two soles side by side just fit."""
     bridge = loads_terrain(
         HEAD
         + box([0.5, 0, -0.1], [3, 4, 0.2])

@@ -137,3 +137,126 @@ def test_report_text(plan):
     feet[k, 1, 2] += 0.02
     text = str(verify(_with(plan, feet=feet)))
     assert f"posture {k}: check 1" in text and "FAILED" in text
+
+
+def _prefix(plan, count):
+    """The plan's first `count` postures as a consistent plan of their own."""
+    from leas_jax.contacts.plan import coverage_of
+
+    last = int(plan.guide_index[count - 1])
+    return _with(
+        plan,
+        q=plan.q[:count],
+        feet=plan.feet[:count],
+        guide_index=plan.guide_index[:count],
+        last_valid_index=last,
+        coverage=coverage_of(plan.guide, last),
+    )
+
+
+def _consistency_messages(report):
+    return [m for _, c, m in report.failures if c == 0]
+
+
+def test_relabelled_last_guide_index_is_caught(plan):
+    """A 4-posture plan claiming the whole guide (last index relabelled to the end, coverage 1)."""
+    short = _prefix(plan, 4)
+    assert verify(short).ok
+    end = len(plan.guide) - 1
+    index = short.guide_index.copy()
+    index[-1] = end
+    forged = _with(short, guide_index=index, last_valid_index=end, coverage=1.0)
+    report = verify(forged)
+    assert not report.ok and any(f"off guide pose {end}" in m for m in _consistency_messages(report))
+
+
+def test_shifted_nan_guides_and_non_unit_quaternions_are_caught(plan):
+    short = _prefix(plan, 6)
+    shifted = verify(_with(short, guide=short.guide + np.array([3.0, 0.0, 0.0, 0.0])))
+    messages = _consistency_messages(shifted)
+    assert any("off guide pose" in m for m in messages) and any("m from guide pose" in m for m in messages)
+    guide = short.guide.copy()
+    guide[len(guide) // 2, 1] = np.nan
+    assert "guide has NaN or inf" in _consistency_messages(verify(_with(short, guide=guide)))
+    q = short.q.copy()
+    q[2, 3:7] *= 1.02
+    assert any("root quaternion has norm 1.02" in m for m in _consistency_messages(verify(_with(short, q=q))))
+    feet = short.feet.copy()
+    feet[0, 0, 3:] *= 1.02
+    assert any(
+        "left foot quaternion has norm 1.02" in m
+        for m in _consistency_messages(verify(_with(short, feet=feet)))
+    )
+
+
+def test_random_tampering_is_caught(plan):
+    """Property: each of 24 seeded random tamperings of a plan (a foot, a joint, the root, a guide
+    index, the guide, a quaternion, NaN, coverage, last index, order) makes verify fail."""
+    from leas_jax.contacts.plan import coverage_of
+
+    base = _prefix(plan, 10)
+    assert verify(base).ok
+    rng = np.random.default_rng(7)
+    talos = load_talos()
+    lower, upper = talos.model.lowerPositionLimit, talos.model.upperPositionLimit
+
+    def tamper(kind):
+        q, feet, index, guide = base.q.copy(), base.feet.copy(), base.guide_index.copy(), base.guide.copy()
+        k = int(rng.integers(1, len(q)))
+        change = {}
+        if kind == "foot":
+            side = int(np.flatnonzero(np.isfinite(feet[k, :, 0]))[0])
+            feet[k, side, int(rng.integers(3))] += rng.choice([-1, 1]) * rng.uniform(0.02, 0.2)
+            change["feet"] = feet
+        elif kind == "joint":
+            j = int(rng.integers(7, talos.model.nq))
+            q[k, j] = (
+                upper[j] + rng.uniform(0.05, 0.5) if rng.random() < 0.5 else lower[j] - rng.uniform(0.05, 0.5)
+            )
+            change["q"] = q
+        elif kind == "root":
+            q[k, int(rng.integers(3))] += rng.choice([-1, 1]) * rng.uniform(0.05, 0.3)
+            change["q"] = q
+        elif kind == "guide index":
+            far = np.flatnonzero(np.hypot(*(guide[:, :2] - guide[index[k], :2]).T) > 0.3)
+            index[k] = int(rng.choice(far))
+            change["guide_index"] = index
+        elif kind == "guide":
+            guide[:, int(rng.integers(2))] += rng.choice([-1, 1]) * rng.uniform(0.3, 3.0)
+            change["guide"] = guide
+        elif kind == "quaternion":
+            q[k, 3:7] *= rng.uniform(1.01, 1.1)
+            change["q"] = q
+        elif kind == "nan":
+            q[k, int(rng.integers(q.shape[1]))] = np.nan
+            change["q"] = q
+        elif kind == "coverage":
+            change["coverage"] = float(
+                np.clip(base.coverage + rng.choice([-1, 1]) * rng.uniform(0.01, 0.5), 0, 1)
+            )
+        elif kind == "last index":
+            last = int(rng.integers(len(guide)))
+            last = last if last != base.last_valid_index else last + 1
+            change.update(last_valid_index=last, coverage=coverage_of(guide, last))
+        else:  # order
+            q[[k - 1, k]], feet[[k - 1, k]] = q[[k, k - 1]], feet[[k, k - 1]]
+            change.update(q=q, feet=feet)
+        return change
+
+    kinds = [
+        "foot",
+        "joint",
+        "root",
+        "guide index",
+        "guide",
+        "quaternion",
+        "nan",
+        "coverage",
+        "last index",
+        "order",
+    ]
+    for trial in range(24):
+        kind = kinds[trial % len(kinds)]
+        change = tamper(kind)
+        report = verify(_with(base, **change))
+        assert not report.ok, f"trial {trial}: {kind} tampering passed"

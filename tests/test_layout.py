@@ -1,6 +1,11 @@
-"""The package's layout: no import cycles, training does not depend on evaluation."""
+"""The package's layout: no import cycles, training does not depend on evaluation; the test tiers."""
+
+import subprocess
+import sys
+from pathlib import Path
 
 import import_graph
+from conftest import SLOW_TIER
 
 
 def test_no_import_cycles():
@@ -37,3 +42,29 @@ def test_a_cycle_is_found(tmp_path):
     assert edges["leas_jax.sub.b"] == {"leas_jax.c"}
     assert edges["leas_jax.d"] == set()
     assert import_graph.cycles(edges) == [["leas_jax.a", "leas_jax.c", "leas_jax.sub.b"]]
+
+
+def test_the_slow_tier_names_existing_tests():
+    """Every id of conftest.SLOW_TIER is collected (a renamed test must not leave the list silently)."""
+    root = Path(__file__).resolve().parents[1]
+    files = sorted({nodeid.split("::")[0] for nodeid in SLOW_TIER})
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pytest",
+            "--collect-only",
+            "-q",
+            "-m",
+            "slow",
+            "-p",
+            "no:cacheprovider",
+            *files,
+        ],
+        capture_output=True,
+        text=True,
+        cwd=root,
+        timeout=300,
+    )
+    collected = set(done.stdout.split())
+    assert sorted(set(SLOW_TIER) - collected) == [], done.stdout[-2000:] + done.stderr[-2000:]

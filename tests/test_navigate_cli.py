@@ -135,3 +135,20 @@ def test_the_report_section_runs_one_query_and_writes_its_plan_and_figure(tmp_pa
         tmp_path / "navigate" / "navigate.png"
     ).is_file()
     assert main(["verify", str(tmp_path / "navigate" / "plan.npz")]) == 0
+
+
+@pytest.mark.slow
+def test_the_real_generator_gives_the_same_plans_with_1_and_2_workers(tmp_path):
+    from leas_jax.navigate.loop import Navigator
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training import load_policy
+
+    terrain = load_terrain(ROOT / "terrains" / "eval_bridge.toml")
+    navigator = Navigator(load_policy(SHIPPED), terrain)
+    queries = [navigator.query((2.0, y, 0.0), (9.5, 5.0)) for y in (2.0, 4.0, 6.0)]
+    one = navigator.run(queries, workers=1)
+    two = navigator.run(queries, workers=2)
+    for a, b in zip(one, two):
+        assert a.reason == b.reason and a.replans == b.replans
+        np.testing.assert_array_equal(a.plan.q, b.plan.q)
+        np.testing.assert_array_equal(a.guide, b.guide)

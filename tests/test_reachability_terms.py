@@ -1,4 +1,4 @@
-"""Hand-made cases for the optional terms of the reachability condition (issue 3 item 6):
+"""Hand-made cases for the optional terms of the reachability condition:
 the lookahead leg cylinders (`leg_forward`), the foothold flatness term
 (`foothold_radius`, `foothold_search`, `foothold_spread`) and the hands term
 (`hand_radius`, `hand_forward`, `hand_lateral`, `hand_bottom`). The calibrated default

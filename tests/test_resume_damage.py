@@ -130,7 +130,7 @@ def test_truncated_config_json_and_a_new_checkpoint_interval_still_resume(tmp_pa
         train(tiny_config(seed=4), run, progress=False, field=field)
 
 
-def test_a_failed_start_leaves_nothing_that_blocks_the_corrected_command(tmp_path, capsys):
+def test_a_failed_start_leaves_nothing_that_blocks_the_corrected_command(tmp_path, capsys, field):
     out = tmp_path / "run"
     bad = tmp_path / "bad.toml"
     bad.write_text('name = "x"\n')
@@ -141,17 +141,16 @@ def test_a_failed_start_leaves_nothing_that_blocks_the_corrected_command(tmp_pat
     with pytest.raises(TerrainError):
         train(tiny_config(terrain=str(bad)), out, progress=False)
     assert not out.exists()
-    # a run that wrote its config but died before its first checkpoint blocks nothing either
+    # a run that wrote its config and a log line but died before its first checkpoint blocks
+    # nothing either: the corrected command starts afresh (stopped here before its first iteration)
     out.mkdir()
     (out / "config.json").write_text(tiny_config(seed=9).to_json())
     (out / "metrics.jsonl").write_text('{"iteration": 1, "env_steps": 999, "wall_s": 1.0}\n')
     (out / "checkpoints").mkdir()
-    config = tiny_config(terrain="tests/data/slab_with_wall.toml", num_timesteps=64 * 8 * 2)
-    result = train(config, out, progress=False)
-    assert result.env_steps == 64 * 8 * 2
-    assert [json.loads(line)["env_steps"] for line in (out / "metrics.jsonl").read_text().splitlines()] == [
-        1024
-    ]
+    config = tiny_config(terrain="tests/data/slab_with_wall.toml")
+    result = train(config, out, progress=False, field=field, stop_after_iterations=0)
+    assert result.env_steps == 0 and [s for s, _ in checkpoint.list_checkpoints(out)] == [0]
+    assert (out / "metrics.jsonl").read_text() == ""
     assert json.loads((out / "config.json").read_text())["seed"] == config.seed
 
 

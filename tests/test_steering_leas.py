@@ -48,7 +48,9 @@ def test_evaluation_lets_the_contact_generator_judge_leas_paths_by_default():
     from leas_jax.steering.rrt import RRTConfig
 
     terrain = loads_terrain(
-        CLIFF_TEXT + "[scenario]\ntarget = [5.5, 0.0]\nstart_region = [[0.9, -0.1], [1.1, 0.1]]\n"
+        # a landing slab beyond 2 m of void: the target stands on ground, as the loader requires
+        CLIFF_TEXT + "[[box]]\ncenter = [5.5, 0.0, -0.1]\nsize = [1.0, 2.0, 0.2]\n"
+        "[scenario]\ntarget = [5.5, 0.0]\nstart_region = [[0.9, -0.1], [1.1, 0.1]]\n"
         "start_yaw_deg = [-5.0, 5.0]\nstart_speed = [0.0, 0.0]\nn_starts = 2\nseed = 0\n"
     )
     policy = FullSpeedAhead()

@@ -112,12 +112,13 @@ def _fails_in_one_line(capsys, argv) -> str:
         ["evaluate", "--scenario", "ground", "--methods", "leas", "--n-starts", "1", "--workers", "0"],
         ["hole-sweep", "--widths", "1", "--methods", "leas", "--n-starts", "1", "--workers", "0"],
         ["arena-check", "--episodes", "4", "--seeds", "0"],
+        ["navigate", "--terrain", "terrains/eval_ground.toml", "--start", "4,4,0", "--goal", "8,4"],
     ],
-    ids=["rollout", "evaluate", "hole-sweep", "arena-check"],
+    ids=["rollout", "evaluate", "hole-sweep", "arena-check", "navigate"],
 )
 def test_policy_commands_refuse_the_hostile_policy(capsys, tmp_path, hostile, command):
     run, marker = hostile
-    out = ["--out", str(tmp_path / ("g.npz" if command[0] == "rollout" else "out"))]
+    out = ["--out", str(tmp_path / ("g.npz" if command[0] in ("rollout", "navigate") else "out"))]
     err = _fails_in_one_line(capsys, [*command, "--checkpoint", str(run), *out])
     assert "--allow-pickle" in err and not marker.exists()
 
@@ -129,3 +130,33 @@ def test_train_init_and_resume_refuse_the_hostile_checkpoint(capsys, tmp_path, h
     assert "--allow-pickle" in _fails_in_one_line(capsys, fine_tune)
     assert "--allow-pickle" in _fails_in_one_line(capsys, ["train", *small, "--out", str(run)])
     assert not marker.exists()
+
+
+def test_convert_rewrites_a_trusted_pickle_run_bit_for_bit(capsys, tmp_path, run_dir):
+    """`leas convert --allow-pickle` turns an earlier version's pickles into .ckpt files holding the
+    same arrays; without --allow-pickle it refuses."""
+    import jax
+
+    payload = checkpoint.read_policy_payload(run_dir / "policy.ckpt")
+    state = checkpoint.load_state(checkpoint.list_checkpoints(run_dir)[-1][1])
+    old = tmp_path / "old_run"
+    (old / "checkpoints").mkdir(parents=True)
+    (old / "config.json").write_text((run_dir / "config.json").read_text())
+    (old / "policy.pkl").write_bytes(pickle.dumps({**payload, "format": "leas-policy-v1"}))
+    (old / "checkpoints" / "step_000000001024.pkl").write_bytes(pickle.dumps(state))
+    assert "--allow-pickle" in _fails_in_one_line(capsys, ["convert", str(old)])
+    assert not (old / "policy.ckpt").exists()
+    assert main(["convert", "--allow-pickle", str(old)]) == 0
+    converted = load_policy(old)
+    assert converted.source.endswith("policy.ckpt")
+    original = load_policy(run_dir)
+    for a, b in zip(
+        jax.tree.leaves((original.normalizer, original.params)),
+        jax.tree.leaves((converted.normalizer, converted.params)),
+    ):
+        assert np.asarray(a).dtype == np.asarray(b).dtype
+        np.testing.assert_array_equal(a, b)
+    new_state, config = checkpoint.read_state(old / "checkpoints" / "step_000000001024.ckpt")
+    assert config == json.loads((run_dir / "config.json").read_text())
+    for a, b in zip(jax.tree.leaves(state), jax.tree.leaves(new_state)):
+        np.testing.assert_array_equal(a, b)

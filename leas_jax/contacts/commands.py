@@ -25,7 +25,7 @@ import numpy as np
 
 # Keys `ContactPlan.save` writes (docs/design.md §6); checked before loading so a
 # truncated or foreign file is named with the missing key.
-from leas_jax.contacts.plan import PLAN_KEYS
+from leas_jax.contacts.plan import MAX_GUIDE_POSES, PLAN_KEYS
 from leas_jax.errors import LeasError, UsageError
 
 
@@ -64,8 +64,16 @@ def _open_npz(path, argument: str):
     return data
 
 
-def _text(data, path, key: str) -> str:
-    value = data[key]
+def _array(data, path, key: str, argument: str) -> np.ndarray:
+    """data[key], with an array np.load refuses (object arrays need pickle) as a one-line UsageError."""
+    try:
+        return np.asarray(data[key])
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise UsageError(f"{argument}: {path}: key '{key}' cannot be read ({exc})") from None
+
+
+def _text(data, path, key: str, argument: str = "--guide") -> str:
+    value = _array(data, path, key, argument)
     if value.dtype.kind not in "US" or value.shape != ():
         raise UsageError(f"{path}: key '{key}' must be a text scalar, got {value.dtype} {list(value.shape)}")
     return str(value.item() if value.dtype.kind == "U" else value.item().decode("utf-8"))
@@ -85,15 +93,20 @@ def load_guide_file(path, argument: str = "--guide") -> GuideFile:
                     f"{argument}: {path}: missing key '{key}' (guide files hold guide [T, 4] "
                     f"and timestep; found {sorted(data.files)})"
                 )
-        guide = np.asarray(data["guide"])
+        guide = _array(data, path, "guide", argument)
         if guide.ndim != 2 or guide.shape[1] != 4 or guide.shape[0] < 1 or guide.dtype.kind not in "fi":
             raise UsageError(
                 f"{argument}: {path}: key 'guide' must be a [T, 4] number array, "
                 f"got {guide.dtype} {list(guide.shape)}"
             )
+        if guide.shape[0] > MAX_GUIDE_POSES:
+            raise UsageError(
+                f"{argument}: {path}: key 'guide' holds {guide.shape[0]} poses, more than the "
+                f"{MAX_GUIDE_POSES} the contact generator accepts (split the guide)"
+            )
         if not np.isfinite(guide).all():
             raise UsageError(f"{argument}: {path}: key 'guide' contains NaN or inf")
-        timestep = np.asarray(data["timestep"])
+        timestep = _array(data, path, "timestep", argument)
         if (
             timestep.size != 1
             or timestep.dtype.kind not in "fi"
@@ -104,11 +117,11 @@ def load_guide_file(path, argument: str = "--guide") -> GuideFile:
                 f"{argument}: {path}: key 'timestep' must be a positive number of seconds, "
                 f"got {timestep.tolist()!r}"
             )
-        terrain_text = _text(data, path, "terrain") if "terrain" in data.files else None
+        terrain_text = _text(data, path, "terrain", argument) if "terrain" in data.files else None
         target = None
         if "target" in data.files:
-            target = np.asarray(data["target"], dtype=np.float64)
-            if target.shape != (2,) or not np.isfinite(target).all():
+            target = _array(data, path, "target", argument)
+            if target.shape != (2,) or target.dtype.kind not in "fi" or not np.isfinite(target).all():
                 raise UsageError(
                     f"{argument}: {path}: key 'target' must be 2 finite numbers (x, y), "
                     f"got {target.tolist()!r}"
@@ -130,6 +143,13 @@ def load_plan_file(path, argument: str = "PLAN"):
     """
     with _open_npz(path, argument) as data:
         missing = [key for key in PLAN_KEYS if key not in data.files]
+        if not missing:
+            poses = _guide_length(data, path, argument)
+            if poses > MAX_GUIDE_POSES:
+                raise UsageError(
+                    f"{argument}: {path}: its guide holds {poses} poses, more than {MAX_GUIDE_POSES} "
+                    "(plans of longer guides are not shown or checked)"
+                )
     if missing:
         raise UsageError(
             f"{argument}: {path}: missing key '{missing[0]}' (a plan file written by "
@@ -143,6 +163,22 @@ def load_plan_file(path, argument: str = "PLAN"):
         raise
     except Exception as exc:  # malformed arrays: report on one line, naming the file
         raise UsageError(f"{argument}: {path}: cannot load the plan ({type(exc).__name__}: {exc})") from None
+
+
+def _guide_length(data, path, argument: str) -> int:
+    """Poses of the 'guide' member of an open .npz, from its header alone (nothing loaded)."""
+    try:
+        with data.zip.open("guide.npy") as member:
+            version = np.lib.format.read_magic(member)
+            read_header = (
+                np.lib.format.read_array_header_1_0
+                if version == (1, 0)
+                else np.lib.format.read_array_header_2_0
+            )
+            shape, _, _ = read_header(member)
+    except (KeyError, ValueError, OSError, zipfile.BadZipFile) as exc:
+        raise UsageError(f"{argument}: {path}: key 'guide' cannot be read ({exc})") from None
+    return int(shape[0]) if shape else 1
 
 
 def _plan_outputs(guide_paths: list[str], out: str) -> list[Path]:
@@ -252,6 +288,10 @@ def cmd_show(args) -> int:
     for argument, path in (("--out", out), ("--png", args.png)):
         if path is not None and not Path(path).parent.is_dir():
             raise UsageError(f"{argument}: {path}: directory {Path(path).parent} does not exist")
+    if args.png is not None and Path(args.png).suffix.lower() != ".png":
+        raise UsageError(f"--png: {args.png}: the footsteps image is a PNG file (name it *.png)")
+    if out.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"--out: {out}: the view is an HTML file (name it *.html)")
     if args.max_postures < 1:
         raise UsageError(f"--max-postures: expected an integer >= 1, got {args.max_postures}")
     plan = load_plan_file(args.plan)

@@ -6,7 +6,6 @@ Host-only (NumPy), not jittable.
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +15,12 @@ from leas_jax.errors import LeasError
 
 # Keys of a plan file, docs/design.md §6: "exactly those keys plus terrain and guide".
 PLAN_KEYS = ("q", "feet", "guide_index", "last_valid_index", "coverage", "terrain", "guide")
+
+# Longest guide the command line plans or shows: 20 000 poses are 2 000 s at the paper's 0.1 s
+# step (over half an hour of walking, far past any scenario's route). A million-pose guide took
+# 340 s and 857 MB to plan and `leas show` 2 GB on it; at this bound both stay within seconds
+# and tens of MB.
+MAX_GUIDE_POSES = 20_000
 
 
 class PlanError(LeasError):
@@ -75,27 +80,22 @@ class ContactPlan:
         The file is written to a temporary file in the same folder, then renamed over
         `path`, so readers never see a partial file.
         """
-        path = os.fspath(path)
-        folder = os.path.dirname(os.path.abspath(path))
-        os.makedirs(folder, exist_ok=True)
-        handle, tmp = tempfile.mkstemp(prefix=os.path.basename(path) + ".", suffix=".tmp", dir=folder)
-        try:
-            with os.fdopen(handle, "wb") as stream:
-                np.savez(
-                    stream,
-                    q=self.q,
-                    feet=self.feet,
-                    guide_index=self.guide_index,
-                    last_valid_index=np.int64(self.last_valid_index),
-                    coverage=np.float64(self.coverage),
-                    terrain=np.str_(self.terrain),
-                    guide=self.guide,
-                )
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        import io
+
+        from leas_jax.files import atomic_write_bytes
+
+        buffer = io.BytesIO()
+        np.savez(
+            buffer,
+            q=self.q,
+            feet=self.feet,
+            guide_index=self.guide_index,
+            last_valid_index=np.int64(self.last_valid_index),
+            coverage=np.float64(self.coverage),
+            terrain=np.str_(self.terrain),
+            guide=self.guide,
+        )
+        atomic_write_bytes(os.fspath(path), buffer.getvalue())
 
     @classmethod
     def load(cls, path) -> ContactPlan:

@@ -8,8 +8,11 @@ the plan (`leas_jax.terrain.loads_terrain`), and equilibrium is hpp-centroidal-
 dynamics' LP on the CoM Pinocchio computes for each saved configuration.
 
 Checks (numbering of docs/design.md §6; 0 is the plan's own consistency):
-    0. arrays: finite q, feet rows all-finite or all-NaN, guide indices in range and
-       non-decreasing, last_valid_index / coverage consistent with the guide;
+    0. arrays: finite q and guide, unit quaternions, feet rows all-finite or all-NaN, guide
+       indices in range and non-decreasing, last_valid_index / coverage consistent with the
+       guide; each posture's root where the generator puts it for its guide pose (yaw of
+       the pose, within max_root_offset_xy horizontally and max_root_offset_z below), and
+       its soles in contact within SOLE_TO_GUIDE_XY of that pose's root;
     1. each foot in contact lies flat on a support surface (sole rectangle 0.20 x 0.13 m
        inside a face whose normal is within the friction cone), within 5 mm and 3 deg;
     2. Pinocchio forward kinematics of q puts the sole frames at `feet` within 1 mm;
@@ -38,6 +41,13 @@ FK_ANGLE_TOL = math.radians(
 )  # rad, sole orientation from FK vs `feet` (the 1 mm of check 2 over a 0.1 m half-sole is ~0.6 deg)
 JOINT_TOL = 1e-6  # rad, rounding allowance on the joint limits
 SAME_PLACEMENT_TOL = 1e-6  # m (and unit-free on rotation matrices): a foot that stays in place
+QUATERNION_TOL = 1e-6  # | |q| - 1 | allowed on every quaternion (the generator's are unit to ~1e-12)
+ROOT_TOL = 1e-6  # m and rad, rounding allowance on the generator's root bounds
+# m, horizontal distance from a sole in contact to its posture's guide root. The generator
+# keeps the root within max_root_offset_xy (0.12 m) of the guide and steps a foot when it
+# lags; over the plans of the four LeaS guides of tests/data and eval_ground (597 postures)
+# the largest distance was 0.215 m. 0.5 m is more than twice that, within the leg's reach.
+SOLE_TO_GUIDE_XY = 0.5
 
 
 @dataclass
@@ -77,7 +87,9 @@ def verify(plan, terrain=None) -> VerificationReport:
     Args:
         plan: a ContactPlan (e.g. `ContactPlan.load(path)`).
         terrain: the Terrain to check against; None (default) rebuilds it from
-            `plan.terrain` (the terrain file text saved with the plan).
+            `plan.terrain` (the terrain file text saved with the plan; for meshes the
+            loader reads the files again and rejects any whose SHA-256 changed).
+            A given terrain's meshes must have the SHA-256 the plan's text records.
 
     Returns:
         VerificationReport listing each (posture, check, message) that fails.
@@ -88,9 +100,11 @@ def verify(plan, terrain=None) -> VerificationReport:
     from leas_jax.contacts.robot.equilibrium import HppEquilibrium, sole_corners
     from leas_jax.contacts.robot.model import load_talos
     from leas_jax.terrain import loads_terrain
+    from leas_jax.terrain.sources import mesh_hash_mismatches
 
     if terrain is None:
         terrain = loads_terrain(plan.terrain, source="<plan terrain>")
+    mesh_mismatches = mesh_hash_mismatches(plan.terrain, terrain)
     talos = load_talos()
     robot = robot_collision(talos)
     objects = terrain_collision(terrain)
@@ -105,6 +119,7 @@ def verify(plan, terrain=None) -> VerificationReport:
     fail = report.failures
 
     # 0. plan consistency
+    fail.extend((-1, 0, message) for message in mesh_mismatches)
     if len(q_all) and (np.any(guide_index < 0) or np.any(guide_index >= len(guide))):
         fail.append((-1, 0, f"guide_index outside [0, {len(guide) - 1}]"))
     if np.any(np.diff(guide_index) < 0):
@@ -122,6 +137,8 @@ def verify(plan, terrain=None) -> VerificationReport:
                 f"{coverage_of(guide, last):.6f} of guide index {last}",
             )
         )
+
+    fail.extend(_guide_consistency(q_all, feet_all, guide, guide_index))
 
     contact = np.zeros(feet_all.shape[:2], dtype=bool)
     for k in range(len(q_all)):
@@ -212,6 +229,69 @@ def verify(plan, terrain=None) -> VerificationReport:
             if len(changed) > 1:
                 fail.append((k, 5, f"both feet change between postures {k - 1} and {k}"))
     return report
+
+
+def _guide_consistency(q_all, feet_all, guide, guide_index) -> list:
+    """Check-0 failures tying the postures to the guide: finite guide, unit quaternions, each
+    root within the generator's bounds of its guide pose, soles in contact near that pose."""
+    from leas_jax.contacts.planner.generator import GeneratorConfig
+
+    found = []
+    if not np.all(np.isfinite(guide)):
+        return [(-1, 0, "guide has NaN or inf")]
+    config = GeneratorConfig()
+    in_range = (guide_index >= 0) & (guide_index < len(guide))
+    for k in range(len(q_all)):
+        q = q_all[k]
+        if not np.all(np.isfinite(q)):
+            continue  # reported by the posture loop
+        norm = float(np.linalg.norm(q[3:7]))
+        if abs(norm - 1.0) > QUATERNION_TOL:
+            found.append((k, 0, f"root quaternion has norm {norm:.6f}, not 1"))
+            continue
+        for side in (0, 1):
+            row = feet_all[k, side]
+            if np.all(np.isfinite(row)) and abs(float(np.linalg.norm(row[3:])) - 1.0) > QUATERNION_TOL:
+                found.append(
+                    (k, 0, f"{_foot(side)} quaternion has norm {float(np.linalg.norm(row[3:])):.6f}, not 1")
+                )
+        if not in_range[k]:
+            continue
+        index = int(guide_index[k])
+        pose = guide[index]
+        offset = float(np.hypot(*(q[:2] - pose[:2])))
+        drop = float(pose[2] - q[2])
+        rot = matrix_from_quat_xyzw(q[3:7])
+        yaw_error = abs((math.atan2(rot[1, 0], rot[0, 0]) - pose[3] + math.pi) % (2 * math.pi) - math.pi)
+        tilt = float(np.hypot(rot[2, 0], rot[2, 1]))
+        if (
+            offset > config.max_root_offset_xy + ROOT_TOL
+            or not -ROOT_TOL <= drop <= config.max_root_offset_z + ROOT_TOL
+            or yaw_error > ROOT_TOL
+            or tilt > ROOT_TOL
+        ):
+            found.append(
+                (
+                    k,
+                    0,
+                    f"root is {offset:.3f} m beside, {drop:.3f} m below and {math.degrees(yaw_error):.2f} deg "
+                    f"off guide pose {index} (the generator keeps it within {config.max_root_offset_xy} m, "
+                    f"0 to {config.max_root_offset_z} m below, at the pose's yaw, level)",
+                )
+            )
+        for side in (0, 1):
+            row = feet_all[k, side]
+            if np.all(np.isfinite(row)):
+                distance = float(np.hypot(*(row[:2] - pose[:2])))
+                if distance > SOLE_TO_GUIDE_XY:
+                    found.append(
+                        (
+                            k,
+                            0,
+                            f"{_foot(side)} is {distance:.3f} m from guide pose {index} (> {SOLE_TO_GUIDE_XY} m)",
+                        )
+                    )
+    return found
 
 
 def _foot(side: int) -> str:

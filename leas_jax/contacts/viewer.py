@@ -20,6 +20,7 @@ from __future__ import annotations
 import base64
 import functools
 import html
+import io
 import json
 
 import numpy as np
@@ -155,7 +156,11 @@ def write_footsteps_png(plan, path, dpi: int = 120) -> None:
         fontsize=8,
         framealpha=0.8,
     )
-    fig.savefig(str(path), dpi=dpi, bbox_inches="tight")
+    from leas_jax.files import atomic_write_bytes
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
+    atomic_write_bytes(path, buffer.getvalue())
 
 
 # ----------------------------------------------------------------------------- HTML

@@ -41,7 +41,7 @@ def arena_check(
     """Speed, safety and failure breakdown of a policy.
 
     Args:
-        checkpoint: run directory or policy.pkl.
+        checkpoint: run directory or policy.ckpt.
         episodes: arena episodes per seed (400 steps each, the env's random resets).
         seeds: evaluation seeds of the arena episodes.
         ground_episodes: eval_ground episodes of the speed test (seed 2, as `make run`'s report).

@@ -7,9 +7,10 @@ from pathlib import Path
 
 from leas_jax.errors import UsageError
 from leas_jax.eval.scenarios import METHODS, SCENARIOS
+from leas_jax.terrain.loader import MAX_STARTS
 
 
-def _positive_int(name: str, allow_zero: bool = False):
+def _positive_int(name: str, allow_zero: bool = False, maximum: int | None = None):
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -19,6 +20,8 @@ def _positive_int(name: str, allow_zero: bool = False):
             raise argparse.ArgumentTypeError(
                 f"{name} expects an integer >= {0 if allow_zero else 1}, got {text!r}"
             )
+        if maximum is not None and value > maximum:
+            raise argparse.ArgumentTypeError(f"{name} expects an integer <= {maximum}, got {text!r}")
         return value
 
     return parse
@@ -135,10 +138,10 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
     add_allow_pickle_argument(parser, "a policy")
     parser.add_argument(
         "--n-starts",
-        type=_positive_int("--n-starts"),
+        type=_positive_int("--n-starts", maximum=MAX_STARTS),
         default=None,
         metavar="N",
-        help=f"starts per {starts_per} (default: the scenario table's n_starts, 60)",
+        help=f"starts per {starts_per}, at most {MAX_STARTS} (default: the scenario table's n_starts, 60)",
     )
     parser.add_argument(
         "--workers",

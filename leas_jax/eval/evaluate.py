@@ -534,7 +534,7 @@ def evaluate(
     Args:
         scenarios: names from SCENARIOS, or ["all"]; ignored when `terrain_file` is given.
         methods: method names, or None for each scenario's paper methods.
-        checkpoint: run directory or policy.pkl (required by leas / leas_rrt).
+        checkpoint: run directory or policy.ckpt (required by leas / leas_rrt).
         out: output directory (None: write nothing).
         n_starts: starts per cell (default each scenario table's).
         workers: contact-generator and RRT processes (None: one per CPU, or the Ray
@@ -615,7 +615,7 @@ def checkpoint_policies(run_dir, limit: int | None = None) -> list:
     """Deterministic policies of a run's saved training states (paper Fig. 4's learning progression).
 
     Args:
-        run_dir: a `leas train` run directory (config.json, checkpoints/step_*.pkl).
+        run_dir: a `leas train` run directory (config.json, checkpoints/step_*.ckpt).
         limit: keep at most this many, evenly spread from first to last (None: all).
 
     Returns:
@@ -633,7 +633,7 @@ def checkpoint_policies(run_dir, limit: int | None = None) -> list:
         raise UsageError(f"{run_dir}: no config.json (give a `leas train` run directory)")
     found = list_checkpoints(run_dir)
     if not found:
-        raise UsageError(f"{run_dir}: no checkpoints/step_*.pkl")
+        raise UsageError(f"{run_dir}: no checkpoints/step_*.ckpt")
     if limit is not None and len(found) > limit:
         picks = np.unique(np.round(np.linspace(0, len(found) - 1, limit)).astype(int))
         found = [found[i] for i in picks]

@@ -236,14 +236,16 @@ def write_report(
 ) -> Path:
     """Evaluate a `leas run` directory and write report.md, eval.json and PNGs into it.
 
+    The report ends with one `leas navigate` query on eval_bridge (plan, figure, time split).
+
     `out` holds `geometric/` (and, after planner fine-tuning, `planner/`), or
-    is itself a single run directory (with `policy.pkl`).
+    is itself a single run directory (with `policy.ckpt`).
 
     Host function (loads files, runs jitted rollouts and contact planning, writes files).
     """
     out = Path(out)
     geometric = out / "geometric" if (out / "geometric").is_dir() else out
-    planner = out / "planner" if (out / "planner" / "policy.pkl").exists() else None
+    planner = out / "planner" if (out / "planner" / "policy.ckpt").exists() else None
     lines = [f"# LeaS run `{out.name}`", ""]
     section, results = _geometric_section(geometric, out, n_episodes)
     lines += section
@@ -255,6 +257,11 @@ def write_report(
     section, results = _baseline_section(planner or geometric, out, baseline_starts, workers)
     lines += section
     summary["baselines"] = results
+    from leas_jax.navigate.report import navigate_section
+
+    section, results = navigate_section(planner or geometric, out, workers=workers)
+    lines += section
+    summary["navigate"] = results
     atomic_write_text(out / "eval.json", json.dumps(summary, indent=2, default=float))
     path = out / "report.md"
     atomic_write_text(path, "\n".join(lines))

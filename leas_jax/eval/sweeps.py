@@ -66,7 +66,7 @@ def hole_width_sweep(
     Args:
         widths: hole widths (m) across the line to the target, each in (0, 7].
         methods: steering methods (`leas_jax.eval.scenarios.METHODS`).
-        checkpoint: run directory or policy.pkl (needed by leas and leas_rrt).
+        checkpoint: run directory or policy.ckpt (needed by leas and leas_rrt).
         n_starts: starts per width (default the scenario's 60).
         workers: contact-generator processes (None: one per CPU; 0: in-process).
         out: directory for hole_sweep.json, hole_sweep.md, hole_sweep.png and one

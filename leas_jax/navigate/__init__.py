@@ -11,7 +11,7 @@ report section). Attributes are imported lazily so
 that `import leas_jax.navigate` (and the CLI's parser) loads no JAX.
 """
 
-import importlib
+from leas_jax.lazy import lazy_getattr
 
 _LAZY = {
     "navigate": "leas_jax.navigate.loop",
@@ -25,8 +25,4 @@ _LAZY = {
 
 __all__ = sorted(_LAZY)
 
-
-def __getattr__(name):
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'leas_jax.navigate' has no attribute {name!r}")
+__getattr__ = lazy_getattr(__name__, globals(), _LAZY)

@@ -78,7 +78,10 @@ def cmd_navigate(args) -> int:
         raise UsageError(f"--checkpoint: {args.checkpoint}: no such file or directory")
     from leas_jax.training import load_policy
 
-    policy = load_policy(args.checkpoint)
+    policy = load_policy(args.checkpoint, allow_pickle=args.allow_pickle)
+    v_max = policy.config.env.v_max
+    if not 0.0 <= args.speed <= v_max:
+        raise UsageError(f"--speed {args.speed:g}: expected a speed in [0, {v_max:g}] m/s (the env's v_max)")
     x, y, yaw = args.start
     start = (x, y, math.radians(yaw) if args.degrees else yaw)
 
@@ -122,6 +125,8 @@ def cmd_navigate(args) -> int:
 
 def register(subparsers) -> None:
     """Add `navigate` to the `leas` parser."""
+    from leas_jax.arguments import add_allow_pickle_argument
+
     parser = subparsers.add_parser(
         "navigate",
         help="verified contact plan from a start to a goal",
@@ -131,7 +136,8 @@ def register(subparsers) -> None:
         "contact plan (docs/design.md §6 format; `leas verify` checks it). Exit code 0: "
         "goal reached; 1: not reached (the best partial plan is written); 2: bad input.",
     )
-    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.pkl")
+    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.ckpt")
+    add_allow_pickle_argument(parser, "a policy")
     parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain file (TOML)")
     parser.add_argument(
         "--start",

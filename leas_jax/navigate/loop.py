@@ -22,6 +22,7 @@ their generator tasks in flight together, as `leas evaluate` does).
 from __future__ import annotations
 
 import concurrent.futures
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -96,6 +97,16 @@ class _State:
     unreachable: str | None = None  # the first search reason that the goal cannot be reached
     seconds: dict = field(default_factory=lambda: {"search": 0.0, "rollout": 0.0, "contact_planning": 0.0})
     done: NavigationResult | None = None
+
+
+@functools.lru_cache(maxsize=1)
+def _jitted_terms():
+    """`reachability.terms` jitted (its config static), built once."""
+    import jax
+
+    from leas_jax.env import reachability
+
+    return jax.jit(reachability.terms, static_argnums=2)
 
 
 def _fmt(xy) -> str:
@@ -180,15 +191,11 @@ class Navigator:
 
     def _failing_terms(self, pose) -> list[str]:
         """Names of the parts of the condition a pose [4] fails (solid_ground: the void under it)."""
-        import jax
         import jax.numpy as jnp
 
-        from leas_jax.env import reachability
         from leas_jax.steering.baselines import lift_checked
 
-        parts = jax.jit(reachability.terms, static_argnums=2)(
-            self.field, jnp.asarray(pose, jnp.float32), self.env.reachability
-        )
+        parts = _jitted_terms()(self.field, jnp.asarray(pose, jnp.float32), self.env.reachability)
         failing = [k for k, v in parts.items() if not bool(v)]
         _, ok = lift_checked(
             self.field, np.asarray(pose)[None, [0, 1, 3]], self.env.nominal_root_height, self.env.reachability
@@ -199,13 +206,16 @@ class Navigator:
 
     # ---- the parts of one attempt --------------------------------------------------------
     def _route_search(self, state: _State, pose, route) -> SearchResult:
-        """Search leg by leg through the route points; stops at the first leg that fails."""
+        """Search leg by leg through the route points [R, 2] from a pose (x, y, z, yaw), each leg
+        from where the last one ended; stops at the first leg that fails (its reason is the
+        result's). Raises ValueError when the pose has no valid lattice node near it."""
         cfg = self.config.search
         lattice = self.lattice
         adjacency = graph(lattice, state.penalty, cfg) if state.penalty.any() else self.graph
-        paths, waypoints, current = [], [], np.asarray(pose, np.float64)[[0, 1, 3]]
+        paths, waypoints, current, cost = [], [], np.asarray(pose, np.float64)[[0, 1, 3]], 0.0
         for point in route:
             leg = search(lattice, current, point, cfg, adjacency=adjacency)
+            cost += leg.cost
             paths.append(leg.path if not paths else leg.path[1:])
             # a reached leg ends at the point itself (its goal node lies up to goal_radius off it,
             # and the policy stops within switch distance of its last waypoint)
@@ -221,7 +231,7 @@ class Navigator:
             reason=leg.reason,
             path=path,
             waypoints=np.concatenate(waypoints),
-            cost=float("nan"),
+            cost=cost,
             length=float(np.hypot(*np.diff(path[:, :2], axis=0).T).sum()) if len(path) > 1 else 0.0,
             end_distance=leg.end_distance,
         )
@@ -353,7 +363,8 @@ class Navigator:
             )
         last, total = int(result.last_valid_index), len(guide)
         outcome = metrics.outcome(guide, query.goal, result.coverage, last, plan=result.plan)
-        if last >= 0 and (state.best is None or outcome.final_distance < state.best[0]):
+        # the plan returned: a successful one, else the one whose valid part ends nearest the goal
+        if outcome.success or (last >= 0 and (state.best is None or outcome.final_distance < state.best[0])):
             state.best = (outcome.final_distance, result.plan, guide)
         # where the generator stopped (None: it covered the whole guide, the policy stopped short)
         failure = None

@@ -16,16 +16,17 @@ import numpy as np
 
 
 def navigate_section(
-    checkpoint, out, scenario: str = "bridge", workers: int = 2, terrain_file=None
+    checkpoint, out, scenario: str = "bridge", workers: int = 2, terrain_file=None, allow_pickle: bool = False
 ) -> tuple[list[str], dict]:
     """One navigate query on terrains/eval_<scenario>.toml (or `terrain_file`, with a [scenario] table).
 
     Args:
-        checkpoint: run directory or policy.pkl.
+        checkpoint: run directory or policy file (`leas_jax.training.load_policy`).
         out: the report's directory; the query writes `navigate/plan.npz` and `navigate/navigate.png`.
         scenario: evaluation scenario name (eval_bridge: the 0.30 m beam LeaS alone misses).
         workers: contact-generator processes.
         terrain_file: another terrain file with a [scenario] table instead.
+        allow_pickle: also read a legacy pickle policy (`load_policy`).
 
     Returns:
         (markdown lines, summary dict).
@@ -41,7 +42,9 @@ def navigate_section(
     goal = np.asarray(terrain.scenario.target, np.float64)
     centre = region.mean(axis=0)
     start = (float(centre[0]), float(centre[1]), math.atan2(goal[1] - centre[1], goal[0] - centre[0]))
-    result = navigate(load_policy(checkpoint), terrain, start, goal, workers=workers)
+    result = navigate(
+        load_policy(checkpoint, allow_pickle=allow_pickle), terrain, start, goal, workers=workers
+    )
     folder = Path(out) / "navigate"
     folder.mkdir(parents=True, exist_ok=True)
     figure = None

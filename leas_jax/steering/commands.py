@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from leas_jax.contacts.plan import MAX_GUIDE_POSES
 from leas_jax.errors import UsageError
 
 
@@ -27,10 +28,9 @@ def _floats(count: int, name: str):
     return parse
 
 
-# Longest horizon `leas rollout` accepts: 20 000 steps is 2 000 s (over half an hour of walking at
-# the paper's 0.1 s step), far past any scenario's route, and keeps the guide, its plan and
-# `leas show`'s page within memory (`leas plan` refuses longer guides, MAX_GUIDE_POSES).
-MAX_ROLLOUT_STEPS = 20_000
+# Longest horizon `leas rollout` accepts: its guide (horizon + 1 poses) is one `leas plan` and
+# `leas show` accept (MAX_GUIDE_POSES, 2 000 s at the paper's 0.1 s step).
+MAX_ROLLOUT_STEPS = MAX_GUIDE_POSES - 1
 
 
 def _horizon(text: str) -> int:

@@ -18,8 +18,8 @@ oriented-path.cc):
    changes its velocity gently over the whole duration: a start velocity
    across the goal direction decays over the path instead of within 0.1 s;
 3. the root yaw is the direction of the horizontal velocity
-   (`Kinodynamic/forceYawOrientation`, set by every Talos scenario of
-   hpp-rbprm-corba), held while the robot is still.
+   (`Kinodynamic/forceYawOrientation`, set by hpp-rbprm-corba's Talos
+   flat-ground and navigation scenarios), held while the robot is still.
 
 With non-zero end velocities some durations longer than an axis's minimum
 time have no bounded trajectory at all (HPP's "infeasible intervals", e.g.
@@ -30,7 +30,7 @@ uses the intervals of the bang-bang family). The kinodynamic RRT (`rrt.py`)
 keeps the former synchronisation, +-a_max with a lower cruise velocity
 (`steer(..., sync="cruise")`): with HPP's, its search no longer crosses
 tests/test_steering_rrt.py's 0.30 m beam at seed 0 within that test's 3000
-iterations (HPP's curved local paths stay on a narrow beam less often).
+iterations.
 
 Decisions (document, not paper): the path starts with the initial velocity
 along the start heading (paper §IV-B: "the initial velocity direction of the
@@ -292,7 +292,7 @@ def steer(
         raise ValueError(f"rbkino: sync {sync!r} is not one of {SYNCS}")
     if sync == "hpp":
         t1, tc, t2, a1, vc, ok = fixed_time_profile(T, p1 - p0, v0, v1, v_max, a_max)
-        if not np.all(ok):  # never met (8000 random states); an error, not a wrong path
+        if not np.all(ok):  # an error, not a wrong path
             raise ValueError(
                 f"rbkino: no fixed-time profile of {T} s from v0={v0} to v1={v1} over {p1 - p0} m"
             )

@@ -14,6 +14,14 @@ The guide path is, one pose every `timestep`:
 2. rotation in place to face the goal, over exactly `rotation_steps` steps
    at constant angular velocity (shortest direction);
 3. the straight line to the goal at `target_speed`, the last pose on the goal.
+
+HPP's own straight-line steering method (hpp-core src/steering-method/straight.cc,
+`StraightPath::impl_compute`: `space_->interpolate(initial_, end_, u)`) turns
+the root while it translates, over the whole path; the paper's RBLin turns
+first, in a tuned number of steps, which is what this follows. At 100 steps a
+180 degree turn runs at 18 deg/s, under the pi/9 rad/s (20 deg/s) yaw rate the
+contact generator's step triggers are sized for (`GeneratorConfig.step_trigger_yaw`);
+docs/results/2026-12-01-table2-baselines/ measures where it stops following.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "terrain",
         help="generate, show and export terrain files",
-        description="Generate, show and export terrain files (TOML, format v1).",
+        description="Generate, show and export terrain files (TOML, format v1; v2 adds [[mesh]] and [elevation]).",
     )
     commands = parser.add_subparsers(dest="terrain_command", metavar="COMMAND", required=True)
 

@@ -1,10 +1,13 @@
 """Terrain exports: MuJoCo MJCF scene and triangle meshes (trimesh).
 
-Host code; not jittable.
+Host code; not jittable. Files are written atomically (a temporary file in the target's
+folder, then renamed): a failed export leaves no partial file.
 """
 
 from __future__ import annotations
 
+import os
+import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
@@ -26,10 +29,13 @@ def _fmt(values) -> str:
 
 
 def terrain_to_mjcf(terrain: Terrain) -> str:
-    """MuJoCo scene of a terrain: one `<geom type="box">` per box in the world body.
+    """MuJoCo scene of a terrain: one `<geom type="box">` per box, one mesh geom per mesh.
 
     Geoms are named box0, box1, ... in box order; `size` holds the half extents and
-    `quat` the orientation in MuJoCo's (w, x, y, z) order.
+    `quat` the orientation in MuJoCo's (w, x, y, z) order. Meshes (`Terrain.meshes`) are
+    assets mesh0, mesh1, ... with their world-frame vertices and faces inline, so the
+    scene needs no other file; MuJoCo ray casts them triangle by triangle (its
+    collisions use their convex hulls). `inertia="shell"` lets open meshes compile.
 
     Args:
         terrain: the terrain.
@@ -50,6 +56,7 @@ def terrain_to_mjcf(terrain: Terrain) -> str:
         # without materials: every geom gets one.
         "  <asset>",
         '    <material name="terrain" rgba="0.62 0.60 0.55 1"/>',
+        *_mesh_assets(terrain),
         "  </asset>",
         "  <default>",
         '    <geom type="box" material="terrain"/>',
@@ -62,24 +69,42 @@ def terrain_to_mjcf(terrain: Terrain) -> str:
             f'    <geom name="box{index}" type="box" pos="{_fmt(box.center)}" '
             f'size="{_fmt(box.half)}" quat="{_fmt(box.quaternion_wxyz)}"/>'
         )
+    for index in range(len(terrain.meshes)):
+        lines.append(f'    <geom name="mesh{index}" type="mesh" mesh="mesh{index}"/>')
     lines += ["  </worldbody>", "</mujoco>", ""]
     return "\n".join(lines)
 
 
+def _mesh_assets(terrain: Terrain) -> list[str]:
+    """`<mesh>` asset lines of the terrain's meshes (vertices with float64 round-trip digits)."""
+    return [
+        f'    <mesh name="mesh{index}" inertia="shell" vertex="{_fmt(mesh.vertices.reshape(-1))}" '
+        f'face="{" ".join(str(int(f)) for f in mesh.faces.reshape(-1))}"/>'
+        for index, mesh in enumerate(terrain.meshes)
+    ]
+
+
 def terrain_to_mesh(terrain: Terrain):
-    """Triangle mesh of all boxes (12 triangles per box, outward normals), world frame.
+    """Triangle mesh of all boxes (12 triangles per box, outward normals), then of the meshes, world frame.
 
     Returns:
-        trimesh.Trimesh with 8 vertices and 12 faces per box, boxes in order.
+        trimesh.Trimesh with 8 vertices and 12 faces per box, boxes in order, then each
+        of `terrain.meshes` as it is (its orientation kept).
     """
     import trimesh
 
     unit = trimesh.creation.box(extents=[1.0, 1.0, 1.0])
-    vertices, faces = [], []
-    for index, box in enumerate(terrain.boxes):
+    vertices, faces = [np.zeros((0, 3))], [np.zeros((0, 3), dtype=np.int64)]
+    count = 0
+    for box in terrain.boxes:
         # unit-cube corners scaled to the box then rotated and moved into the world
         vertices.append(box.center + (unit.vertices * box.size) @ box.rotation.T)
-        faces.append(unit.faces + 8 * index)
+        faces.append(unit.faces + count)
+        count += 8
+    for mesh in terrain.meshes:
+        vertices.append(mesh.vertices)
+        faces.append(mesh.faces + count)
+        count += len(mesh.vertices)
     return trimesh.Trimesh(vertices=np.concatenate(vertices), faces=np.concatenate(faces), process=False)
 
 
@@ -95,10 +120,24 @@ def export_terrain(terrain: Terrain, path) -> None:
         raise TerrainError(
             f"{path}: unknown export format {suffix or '(none)'!r}: use one of {', '.join(EXPORT_EXTENSIONS)}"
         )
+    if suffix == ".xml":
+        data = terrain_to_mjcf(terrain).encode("utf-8")
+    else:
+        data = terrain_to_mesh(terrain).export(file_type=suffix[1:])
+        data = data.encode("utf-8") if isinstance(data, str) else data
     try:
-        if suffix == ".xml":
-            path.write_text(terrain_to_mjcf(terrain), encoding="utf-8")
-        else:
-            terrain_to_mesh(terrain).export(str(path), file_type=suffix[1:])
+        _write_atomic(path, data)
     except OSError as err:
         raise TerrainError(f"{path}: cannot write export: {err.strerror or err}") from None
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    """Write bytes to path through a temporary file in its folder, renamed over it."""
+    handle, temp = tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=f".{path.name}.")
+    try:
+        with os.fdopen(handle, "wb") as out:
+            out.write(data)
+        os.replace(temp, path)
+    except BaseException:
+        Path(temp).unlink(missing_ok=True)
+        raise

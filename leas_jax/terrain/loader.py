@@ -1,4 +1,5 @@
-"""Read and validate terrain files (TOML, docs/design.md §4 terrain format v1).
+"""Read and validate terrain files (TOML, docs/design.md §4 terrain format v1; v2 adds
+`[[mesh]]` and `[elevation]`, parsed by `leas_jax.terrain.sources`).
 
 Every rejection is a TerrainError with one line naming the file, the key and the value:
 `terrains/x.toml: box[3].size = [1.0, 0.0, 0.2]: every element must be > 0`.
@@ -14,6 +15,7 @@ import numpy as np
 import tomllib
 
 from leas_jax.env.config import EnvConfig
+from leas_jax.terrain import sources
 from leas_jax.terrain.model import Box, Scenario, Terrain, TerrainError
 
 MAX_CELLS = 50_000_000  # docs/design.md §4: larger heightfields are rejected
@@ -35,8 +37,8 @@ MAX_YAW_DEG = 360.0  # |start_yaw_deg|, and the range spans at most one turn
 # Speeds a scenario may start at: the env's bound on the root speed (EnvConfig.v_max).
 MAX_START_SPEED = EnvConfig().v_max
 
-TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario"}
-TOP_REQUIRED = ("name", "bounds", "void_height", "resolution", "box")
+TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario"} | sources.TOP_KEYS
+TOP_REQUIRED = ("name", "bounds", "void_height", "resolution")
 BOX_KEYS = {"center", "size", "rpy"}
 BOX_REQUIRED = ("center", "size")
 SCENARIO_KEYS = {"target", "start_region", "start_yaw_deg", "start_speed", "n_starts", "seed", "waypoints"}
@@ -99,15 +101,21 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
         check.fail("resolution", data["resolution"], "must be > 0")
     check_raster(check, bounds, resolution, data)
 
-    raw_boxes = data["box"]
+    raw_boxes = data.get("box", [])
     if not isinstance(raw_boxes, list) or not all(isinstance(b, dict) for b in raw_boxes):
         check.fail("box", raw_boxes, "must be an array of tables ([[box]])")
-    if not raw_boxes:
+    if not raw_boxes and not sources.has_geometry(data):
+        if "box" not in data:
+            raise TerrainError(
+                f"{source}: box: missing required key in the top level (or [[mesh]], [elevation])"
+            )
         check.fail("box", raw_boxes, "needs at least one [[box]]")
     if len(raw_boxes) > MAX_BOXES:
         raise TerrainError(f"{source}: box: {len(raw_boxes)} boxes exceed the bound of {MAX_BOXES}")
     boxes = tuple(_box(check, f"box[{k}]", raw) for k, raw in enumerate(raw_boxes))
-    lowest_top = min(float(box.aabb()[1, 2]) for box in boxes)
+    meshes, text = sources.load_sources(check, data, text, path)
+    solids = boxes + meshes  # both have aabb() and column_top(x, y)
+    lowest_top = min(float(solid.aabb()[1, 2]) for solid in solids)
     if void_height >= lowest_top:
         check.fail(
             "void_height",
@@ -118,7 +126,7 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
     scenario = None
     if "scenario" in data:
         scenario = _scenario(check, data["scenario"], bounds)
-        check_scenario_ground(check, data["scenario"], scenario, boxes, void_height)
+        check_scenario_ground(check, data["scenario"], scenario, solids, void_height)
     return Terrain(
         name=name,
         bounds=bounds,
@@ -128,6 +136,7 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
         scenario=scenario,
         text=text,
         path=path,
+        meshes=meshes,
     )
 
 

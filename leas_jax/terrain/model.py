@@ -1,8 +1,9 @@
-"""Terrain data model: boxes over a void, their heightfield, support surfaces and exports.
+"""Terrain data model: boxes and meshes over a void, their heightfield, support surfaces and exports.
 
 Host code (NumPy); nothing here can be jitted. The file format is docs/design.md §4 (terrain
-format v1); the interface is docs/architecture.md. All coordinates are world frame,
-metres, z up.
+format v1; v2 adds meshes and an elevation map, `leas_jax.terrain.sources`, whose geometry
+is `leas_jax.terrain.mesh`); the interface is docs/architecture.md. All coordinates are
+world frame, metres, z up.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from leas_jax.errors import TerrainError
+from leas_jax.terrain.mesh import MeshIndex, support_polygons
 
 # Boxes are closed sets: a raster point exactly on a box edge belongs to it. Grid
 # coordinates xmin + i*res carry rounding errors of ~1e-15 m, so the slab test
@@ -218,18 +220,25 @@ class Scenario:
 
 @dataclass(frozen=True, eq=False)
 class SupportSurface:
-    """A planar face where a foot may rest.
+    """A convex planar face where a foot may rest.
 
     Attributes:
         vertices: [N, 3] polygon, world frame, counter-clockwise seen along -normal
             (i.e. looking at the face from outside, from above).
         normal: [3] outward unit normal, world frame.
-        box_index: index of the box in `Terrain.boxes` the face belongs to.
+        box_index: index of the box in `Terrain.boxes` the face belongs to, -1 for a mesh's.
+        mesh_index: index of the mesh in `Terrain.meshes` the polygon is cut from, -1 for a box's.
     """
 
     vertices: np.ndarray
     normal: np.ndarray
     box_index: int
+    mesh_index: int = -1
+
+    @property
+    def origin(self) -> str:
+        """'box k' or 'mesh k', for messages."""
+        return f"box {self.box_index}" if self.mesh_index < 0 else f"mesh {self.mesh_index}"
 
     def __post_init__(self):
         object.__setattr__(self, "vertices", _frozen_array(self.vertices, (-1, 3)))
@@ -264,17 +273,18 @@ def face_polygon(box: Box, axis: int, sign: int) -> tuple[np.ndarray, np.ndarray
 
 @dataclass(frozen=True, eq=False)
 class Terrain:
-    """A terrain: a union of boxes over a void (docs/design.md §4).
+    """A terrain: a union of boxes and triangle meshes over a void (docs/design.md §4).
 
     Attributes:
         name: terrain name.
         bounds: [2, 2] [[xmin, ymin], [xmax, ymax]] of the heightfield, world frame, m.
-        void_height: height where no box covers a point, m.
+        void_height: height where no box or mesh covers a point, m.
         resolution: heightfield cell size, m.
         boxes: the boxes.
         scenario: the evaluation scenario, or None (training terrains).
-        text: TOML source of the terrain.
+        text: TOML source of the terrain (with its `[resolved]` table for v2 sources).
         path: file the terrain was read from, or None.
+        meshes: the `[[mesh]]` entries then the `[elevation]` map, as TerrainMesh (world frame).
     """
 
     name: str
@@ -285,11 +295,13 @@ class Terrain:
     scenario: Scenario | None = None
     text: str = ""
     path: str | None = None
+    meshes: tuple = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     def __post_init__(self):
         object.__setattr__(self, "bounds", _frozen_array(self.bounds, (2, 2)))
         object.__setattr__(self, "boxes", tuple(self.boxes))
+        object.__setattr__(self, "meshes", tuple(self.meshes))
         object.__setattr__(self, "void_height", float(self.void_height))
         object.__setattr__(self, "resolution", float(self.resolution))
 
@@ -316,23 +328,29 @@ class Terrain:
 
         Returns:
             [nx, ny] float32: heights[i, j] is the highest point of the union of boxes
-            on the vertical line through (xmin + i*res, ymin + j*res), void_height
-            where no box meets that line.
+            and meshes on the vertical line through (xmin + i*res, ymin + j*res),
+            void_height where nothing meets that line.
         """
         if "raster" not in self._cache:
-            heights = rasterize(self.boxes, self.bounds, self.resolution, self.void_height)
+            heights = rasterize(self.boxes, self.bounds, self.resolution, self.void_height, self.mesh_index())
             heights.setflags(write=False)
             self._cache["raster"] = heights
         return self._cache["raster"]
 
+    def mesh_index(self) -> MeshIndex:
+        """The triangles of all meshes, for vertical ray casts (cached)."""
+        if "mesh_index" not in self._cache:
+            self._cache["mesh_index"] = MeshIndex(self.meshes)
+        return self._cache["mesh_index"]
+
     def height_at(self, xy) -> np.ndarray:
-        """Exact terrain heights by vertical ray cast on the boxes.
+        """Exact terrain heights by vertical ray cast on the boxes and the meshes' triangles.
 
         Args:
             xy: [..., 2] world positions, m (e.g. [N, 2] or [2]).
 
         Returns:
-            [...] float64 heights, void_height where no box is hit.
+            [...] float64 heights, void_height where nothing is hit.
 
         Raises:
             TerrainError: xy not of shape [..., 2] or not finite.
@@ -351,25 +369,33 @@ class Terrain:
             if len(candidates):
                 sel = flat[candidates]
                 top[candidates] = np.maximum(top[candidates], box.column_top(sel[:, 0], sel[:, 1]))
+        if self.meshes:
+            top = np.maximum(top, self.mesh_index().column_top(flat))
         heights = np.where(np.isfinite(top), top, self.void_height)
         return heights.reshape(points.shape[:-1])
 
     def support_surfaces(self, mu: float = 0.5) -> list[SupportSurface]:
-        """Box faces a foot may rest on: outward normal within the friction cone.
+        """Faces a foot may rest on: outward normal within the friction cone.
 
-        A face qualifies when the angle between its outward normal and +z is at most
+        A box face qualifies when the angle between its outward normal and +z is at most
         atan(mu). Faces whose centre is covered by another box (a point 1 mm above the
         centre lies inside it) are left out; partly covered faces are returned whole.
+        Meshes give convex polygons of adjacent coplanar triangles within the cone
+        (`leas_jax.terrain.mesh.support_polygons`).
 
         Args:
             mu: friction coefficient (> 0).
 
         Returns:
-            list of SupportSurface, in box order.
+            list of SupportSurface, the boxes' in box order, then the meshes'.
         """
         if not mu > 0.0:
             raise TerrainError(f"support_surfaces: mu = {mu!r}: must be > 0")
         min_nz = math.cos(math.atan(mu))
+        meshes = [
+            SupportSurface(p.vertices, p.normal, -1, p.mesh_index)
+            for p in support_polygons(self.meshes, mu, self.height_at)
+        ]
         faces = []  # (box index, corners [4, 3], normal [3])
         for index, box in enumerate(self.boxes):
             for axis in range(3):
@@ -378,7 +404,7 @@ class Terrain:
                     if normal[2] >= min_nz - 1e-12:
                         faces.append((index, corners, normal))
         if not faces:
-            return []
+            return meshes
         owner = np.array([f[0] for f in faces])
         probes = np.array([f[1].mean(axis=0) + _BURIED_PROBE * f[2] for f in faces])  # [F, 3]
         buried = np.zeros(len(faces), dtype=bool)
@@ -389,21 +415,22 @@ class Terrain:
             for (index, corners, normal), hidden in zip(faces, buried)
             if not hidden
         ]
-        return surfaces
+        return surfaces + meshes
 
     def to_mjcf(self) -> str:
-        """MuJoCo scene of the terrain: one `<geom type="box">` per box in the world body.
+        """MuJoCo scene of the terrain: one `<geom type="box">` per box, one mesh geom per mesh.
 
         Returns:
             MJCF XML text; geoms are named box0, box1, ... in box order, `size` is the half
-            extents and `quat` the orientation in MuJoCo's (w, x, y, z) order.
+            extents and `quat` the orientation in MuJoCo's (w, x, y, z) order; meshes are
+            mesh0, mesh1, ... with their world-frame vertices inline.
         """
         from leas_jax.terrain.export import terrain_to_mjcf
 
         return terrain_to_mjcf(self)
 
     def to_mesh(self):
-        """trimesh.Trimesh of all boxes (12 triangles each), world frame."""
+        """trimesh.Trimesh of all boxes (12 triangles each) then all meshes' triangles, world frame."""
         from leas_jax.terrain.export import terrain_to_mesh
 
         return terrain_to_mesh(self)
@@ -454,17 +481,21 @@ def raster_shape(bounds, resolution: float) -> tuple[int, int]:
     return int(round(extent[0] / resolution)) + 1, int(round(extent[1] / resolution)) + 1
 
 
-def rasterize(boxes, bounds, resolution: float, void_height: float) -> np.ndarray:
-    """Highest box point above every raster point.
+def rasterize(
+    boxes, bounds, resolution: float, void_height: float, meshes: MeshIndex | None = None
+) -> np.ndarray:
+    """Highest box or mesh point above every raster point.
 
     Each box only touches the raster window of its axis-aligned bounding box, which is
-    evaluated in chunks of at most _CHUNK_POINTS points.
+    evaluated in chunks of at most _CHUNK_POINTS points; triangles likewise
+    (`MeshIndex.raster`).
 
     Args:
         boxes: sequence of Box.
         bounds: [2, 2] [[xmin, ymin], [xmax, ymax]], world, m.
         resolution: cell size, m.
-        void_height: height where no box is met, m.
+        void_height: height where nothing is met, m.
+        meshes: the terrain's triangles, or None.
 
     Returns:
         [nx, ny] float32 heights at (xmin + i*res, ymin + j*res).
@@ -486,4 +517,6 @@ def rasterize(boxes, bounds, resolution: float, void_height: float) -> np.ndarra
             xs = bounds[0, 0] + np.arange(a, b) * resolution
             column = box.column_top(xs[:, None], ys[None, :])
             np.maximum(top[a:b, j0 : j1 + 1], column, out=top[a:b, j0 : j1 + 1])
+    if meshes is not None and len(meshes):
+        np.maximum(top, meshes.raster(bounds, resolution, (nx, ny)), out=top)
     return np.where(np.isfinite(top), top, void_height).astype(np.float32)

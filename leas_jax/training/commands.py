@@ -72,10 +72,10 @@ def add_training_arguments(parser) -> None:
         help="condition the policy trains with (both phases): presets (the default: "
         "TRAINING_REACHABILITY, the cylinders alone) or calibrated (ReachabilityConfig(): "
         "lookahead legs, foothold and gripper disks, 95.5 / 90.2 %% sensitivity / specificity "
-        'against the walking generator on fresh poses; the README\'s "Contact generator" '
-        "gives the trade) or learned (the network of checkpoints/feasibility/walking.npz, trained "
-        "on the generator's walking verdicts; in planner mode refreshed on the generator's "
-        "verdicts on the policy's guides: docs/results/2026-12-01-feasibility)",
+        "against the walking generator on fresh poses; docs/results/INDEX.md gives the trade) or "
+        "learned (the network of checkpoints/feasibility/walking.npz, trained on the generator's "
+        "walking verdicts; in planner mode refreshed on the generator's verdicts on the policy's "
+        "guides: docs/results/2026-12-01-feasibility)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(

@@ -352,7 +352,7 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
         episodes = rollout(state, field, k_roll)
         return state.replace(key=key), episodes, k_update
 
-    # the learner mostly waits on validation: give the workers every core (the default)
+    # the learner mostly waits on validation: give the workers every core (the default)
     if pool_options.get("workers") is None and pool_options.get("address") is None:
         pool_options = {**pool_options, "workers": available_cpus()}
     pool = ValidationPool(terrain, return_plans=False, **pool_options)

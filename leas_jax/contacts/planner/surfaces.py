@@ -1,7 +1,8 @@
 """Support surfaces as arrays, and sole-rectangle placement tests on them.
 
 Host-only (NumPy), not jittable. Wraps `Terrain.support_surfaces(mu)` (box faces whose
-normal is within the friction cone) with what the generator and the verifier need:
+normal is within the friction cone, and the convex polygons of coplanar mesh triangles,
+`leas_jax.terrain.mesh`) with what the generator and the verifier need:
 plane equations, polygon edges, bounding boxes, the sole orientation on a face and
 the "sole rectangle inside the face polygon" test of docs/design.md §6 check 1.
 
@@ -128,15 +129,24 @@ def coplanar_groups(normals: np.ndarray, offsets: np.ndarray, bbox: np.ndarray) 
             i = parent[i]
         return i
 
+    # Only faces whose offsets lie within the tolerance can share a plane: each face is
+    # compared with that window of the faces sorted by offset (a mesh terrain has
+    # thousands of faces, mostly in planes of their own), the later faces only.
+    by_offset = np.argsort(offsets, kind="stable")
+    sorted_offsets = offsets[by_offset]
+    starts = np.searchsorted(sorted_offsets, offsets - COPLANAR_OFFSET_TOL, side="left")
+    ends = np.searchsorted(sorted_offsets, offsets + COPLANAR_OFFSET_TOL, side="right")
     for i in range(count):
-        same_plane = (np.linalg.norm(normals[i + 1 :] - normals[i], axis=1) < COPLANAR_NORMAL_TOL) & (
-            np.abs(offsets[i + 1 :] - offsets[i]) < COPLANAR_OFFSET_TOL
+        window = by_offset[starts[i] : ends[i]]
+        window = np.sort(window[window > i])
+        same_plane = (np.linalg.norm(normals[window] - normals[i], axis=1) < COPLANAR_NORMAL_TOL) & (
+            np.abs(offsets[window] - offsets[i]) < COPLANAR_OFFSET_TOL
         )
         touching = np.all(
-            (bbox[i + 1 :, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[i + 1 :, 1] >= bbox[i, 0] - TOUCH_TOL),
+            (bbox[window, 0] <= bbox[i, 1] + TOUCH_TOL) & (bbox[window, 1] >= bbox[i, 0] - TOUCH_TOL),
             axis=1,
         )
-        for j in i + 1 + np.flatnonzero(same_plane & touching):
+        for j in window[same_plane & touching]:
             a, b = root(i), root(int(j))
             if a != b:
                 parent[max(a, b)] = min(a, b)
@@ -331,6 +341,9 @@ def _height_bounds(terrain, xy: np.ndarray) -> np.ndarray:
     bound = np.maximum(
         np.max(np.where(hit, top[None, :], -np.inf), axis=1, initial=-np.inf), float(terrain.void_height)
     )
+    if terrain.meshes:
+        # The highest triangle registered in each point's cell bounds the meshes' part.
+        bound = np.maximum(bound, terrain.mesh_index().top_bound(xy))
     return np.where(np.any(hit & tilted[None, :], axis=1), np.inf, bound)
 
 
@@ -361,7 +374,8 @@ def height_at(terrain, xy: np.ndarray) -> np.ndarray:
     (`Box.column_top`) the points inside each box's grown footprint; here the footprints
     are cached arrays, one [N, B] test finds the boxes that hold a point, and only those
     ray cast their points. `column_top` is point-wise and the maximum does not depend on
-    the order, so the heights are identical.
+    the order, so the heights are identical. Meshes are ray cast by `MeshIndex.column_top`,
+    as in `Terrain.height_at`.
     """
     xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     lo, hi, columns = _column_bounds(terrain)
@@ -377,6 +391,8 @@ def height_at(terrain, xy: np.ndarray) -> np.ndarray:
         b = int(near[k])
         idx = np.flatnonzero(hit[:, k])
         top[idx] = np.maximum(top[idx], boxes[b].column_top(xy[idx, 0], xy[idx, 1]))
+    if terrain.meshes:
+        top = np.maximum(top, terrain.mesh_index().column_top(xy))
     return np.where(np.isfinite(top), top, terrain.void_height)
 
 
@@ -441,7 +457,7 @@ def find_support(
         if score < best_score:
             best_score = score
             best_reason = (
-                f"closest face (box {surface.box_index}): plane distance {1000 * dist[s]:.1f} mm, "
+                f"closest face ({surface.origin}): plane distance {1000 * dist[s]:.1f} mm, "
                 f"tilt {np.degrees(angle[s]):.2f} deg, {int((~inside).sum())} sole corners outside"
             )
     for group in np.unique(surfaces.group[on_plane]):

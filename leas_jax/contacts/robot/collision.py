@@ -7,8 +7,9 @@ kinematics of the legs with the upper body rigid at half-sitting
 geometry's local bounding box is moved to the world frame and tested against the
 terrain boxes' bounding boxes first, so that coal only sees pairs that may touch.
 
-Terrain collision objects (`coal.Box` + transform per terrain box) are built once per
-terrain object and cached (`terrain_collision`).
+Terrain collision objects (`coal.Box` + transform per terrain box, and a
+`coal.BVHModelOBBRSS` per square tile of each terrain mesh) are built once per terrain
+object and cached (`terrain_collision`).
 """
 
 from __future__ import annotations
@@ -23,16 +24,21 @@ from leas_jax.contacts.robot.model import LEFT, RIGHT, TalosModel
 # Leg links whose meshes are checked for leg-leg and leg-body self-collision: thigh,
 # shin, ankle pitch and foot (links 1-2 sit inside the pelvis and always touch it).
 SELF_COLLISION_LINKS = (3, 4, 5, 6)
+# Terrain meshes are cut into square tiles of this side (m, by triangle centroid), one
+# BVH each: a robot geometry's bounding box then meets a few tiles instead of one BVH
+# spanning the whole scene, as with the boxes.
+MESH_TILE = 1.0
 
 
 @dataclass
 class TerrainCollision:
-    """coal objects of a terrain's boxes.
+    """coal objects of a terrain's boxes, then of its mesh tiles.
 
     Attributes:
-        shapes: coal.Box per terrain box (full extents).
-        transforms: coal.Transform3s per box (world_R_box, centre).
-        aabb: [B, 2, 3] world axis-aligned bounds (min, max) of each box.
+        shapes: coal.Box per terrain box (full extents), then a coal.BVHModelOBBRSS per
+            mesh tile (world-frame triangles).
+        transforms: coal.Transform3s per object (world_R_box and centre; identity for tiles).
+        aabb: [B, 2, 3] world axis-aligned bounds (min, max) of each object.
     """
 
     shapes: list
@@ -68,9 +74,37 @@ def terrain_collision(terrain) -> TerrainCollision:
                 coal.Transform3s(np.array(box.rotation), np.array(box.center, dtype=np.float64))
             )
             aabb.append(box.aabb())
+        for mesh in terrain.meshes:
+            for tri in mesh_tiles(mesh.triangles, MESH_TILE):
+                shapes.append(_bvh(coal, tri))
+                transforms.append(coal.Transform3s())
+                aabb.append(np.stack([tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)]))
         cached = TerrainCollision(shapes, transforms, np.array(aabb).reshape(-1, 2, 3))
         _TERRAIN_CACHE[terrain] = cached
     return cached
+
+
+def mesh_tiles(triangles: np.ndarray, tile: float) -> list[np.ndarray]:
+    """Triangles [F, 3, 3] grouped by the square tile (side `tile`, m) holding their centroid's xy.
+
+    Returns:
+        list of [F_k, 3, 3] arrays, tiles in row-major order of their (x, y) indices.
+    """
+    cell = np.floor(triangles.mean(axis=1)[:, :2] / tile).astype(np.int64)
+    _, label = np.unique(cell, axis=0, return_inverse=True)
+    label = label.reshape(-1)
+    order = np.argsort(label, kind="stable")
+    return np.split(triangles[order], np.flatnonzero(np.diff(label[order])) + 1)
+
+
+def _bvh(coal, triangles: np.ndarray):
+    """coal.BVHModelOBBRSS of triangles [F, 3, 3] (world frame, three vertices per triangle)."""
+    model = coal.BVHModelOBBRSS()
+    model.beginModel(len(triangles), 3 * len(triangles))
+    model.addVertices(np.ascontiguousarray(triangles.reshape(-1, 3), dtype=np.float64))
+    model.addTriangles(np.arange(3 * len(triangles), dtype=np.int64).reshape(-1, 3))
+    model.endModel()
+    return model
 
 
 class RobotCollision:
@@ -205,7 +239,8 @@ class RobotCollision:
             aabb: [G, 2, 3] `world_aabb(rot, pos)` if already computed.
 
         Returns:
-            list of (geometry index, box index) in collision (empty: collision-free).
+            list of (geometry index, terrain object index) in collision (empty: collision-free);
+            objects are the boxes, then the mesh tiles (`TerrainCollision.shapes`).
         """
         import coal
 

@@ -1,0 +1,93 @@
+"""What the JAX compilation cache of a test run saves (tests/conftest.py).
+
+The tests train the same tiny configs many times, each `train` call building and jitting
+its own program. This script makes the same `train` call three times in one process,
+once without a persistent compilation cache and once with a fresh one (each in its own
+subprocess, so that neither inherits the other's compiled programs), and reports the
+wall time of every call: with the cache, calls after the first load the program instead
+of compiling it.
+
+    python benchmarks/compile_cache.py --out docs/results/2026-12-01-test-compile-cache
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import common  # noqa: E402
+
+CALLS = 3
+
+
+def _calls() -> list[float]:
+    """Wall time (s) of CALLS identical tiny `train` calls in this process (test_train's config)."""
+    import numpy as np
+
+    from leas_jax.env import heightfield_from_raster
+    from leas_jax.training import preset, train
+
+    heights = np.zeros((301, 301), np.float32)
+    heights[200:230, :] = -2.0
+    field = heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0)
+    config = preset(
+        "smoke",
+        num_timesteps=64 * 8 * 2 * 3,
+        num_envs=64,
+        unroll_length=8,
+        num_minibatches=2,
+        num_epochs=2,
+        iterations_per_call=2,
+        checkpoint_every_s=0.0,
+    )
+    times = []
+    with tempfile.TemporaryDirectory() as out:
+        for k in range(CALLS):
+            start = time.perf_counter()
+            train(config, Path(out) / str(k), progress=False, field=field)
+            times.append(round(time.perf_counter() - start, 2))
+    return times
+
+
+def _run(cache_dir: str | None) -> list[float]:
+    env = {k: v for k, v in os.environ.items() if k != "JAX_COMPILATION_CACHE_DIR"}
+    if cache_dir is not None:
+        env["JAX_COMPILATION_CACHE_DIR"] = cache_dir
+    done = subprocess.run(
+        [sys.executable, __file__, "--child"], env=env, capture_output=True, text=True, check=True
+    )
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    common.add_out_argument(parser)
+    args = parser.parse_args(argv)
+    if args.child:
+        print(json.dumps(_calls()))
+        return
+    load = common.load_average()
+    without = _run(None)
+    with tempfile.TemporaryDirectory() as cache:
+        with_cache = _run(cache)
+    payload = {
+        "calls": CALLS,
+        "seconds_without_cache": without,
+        "seconds_with_cache": with_cache,
+        "later_calls_ratio": round(sum(with_cache[1:]) / sum(without[1:]), 3),
+    }
+    print(json.dumps(payload, indent=2))
+    common.save("compile_cache", payload, load, args.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -8,7 +8,6 @@ from types import SimpleNamespace
 import jax
 import jax.numpy as jnp
 import numpy as np
-import pytest
 
 from leas_jax.env import learned_feasibility as lf
 from leas_jax.training import preset, train
@@ -48,7 +47,6 @@ def _fail_at(terrain, guide, timestep, config=None):
     return SimpleNamespace(coverage=(last + 1) / len(guide), last_valid_index=last)
 
 
-@pytest.mark.slow  # ~90 s at load 12 on 2 cores: compiles the planner rollout, update and fit
 def test_the_loop_adds_the_policys_failed_poses_and_refreshes_the_condition(tmp_path, monkeypatch):
     record_file = tmp_path / "failed.txt"
     monkeypatch.setenv("LEAS_TEST_FAILED_POSES", str(record_file))

@@ -97,7 +97,7 @@ TINY = [
 ]
 
 
-@pytest.mark.slow  # the four methods' training and evaluation compile ~10 jitted programs
+@pytest.mark.slow  # 63 s at load 3 on 2 cores (705 s at load 20): four trainings and evaluations compile
 def test_study_runs_end_to_end_on_tiny_settings(tmp_path):
     report = fs.main(["--out", str(tmp_path)] + TINY)
     assert set(report["summary"]) == set(fs.METHODS)

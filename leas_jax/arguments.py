@@ -7,6 +7,7 @@ imports them.
 from __future__ import annotations
 
 import argparse
+import math
 
 
 def positive_int(text: str) -> int:
@@ -18,6 +19,23 @@ def positive_int(text: str) -> int:
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
     return value
+
+
+def comma_floats(count: int, name: str):
+    """argparse type of the argument `name`: `count` finite comma-separated numbers (X,Y,YAW)."""
+
+    def parse(text: str) -> list[float]:
+        try:
+            values = [float(v) for v in text.split(",")]
+        except ValueError:
+            values = []
+        if len(values) != count or not all(math.isfinite(v) for v in values):
+            raise argparse.ArgumentTypeError(
+                f"{name} expects {count} finite comma-separated numbers, got {text!r}"
+            )
+        return values
+
+    return parse
 
 
 def non_negative_seconds(text: str) -> float:

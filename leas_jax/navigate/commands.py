@@ -12,29 +12,12 @@ the CLI imports every command module to build its parser.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from pathlib import Path
 
+from leas_jax.arguments import comma_floats
 from leas_jax.errors import UsageError
-
-
-def _floats(count: int, name: str):
-    """argparse type: `count` finite comma-separated numbers."""
-
-    def parse(text: str) -> list[float]:
-        try:
-            values = [float(v) for v in text.split(",")]
-        except ValueError:
-            values = []
-        if len(values) != count or not all(math.isfinite(v) for v in values):
-            raise argparse.ArgumentTypeError(
-                f"{name} expects {count} finite comma-separated numbers, got {text!r}"
-            )
-        return values
-
-    return parse
 
 
 def _check_output(argument: str, path, suffix: str) -> Path:
@@ -142,14 +125,16 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--start",
         required=True,
-        type=_floats(3, "--start"),
+        type=comma_floats(3, "--start"),
         metavar="X,Y,YAW",
         help="start position (m) and yaw (rad, or degrees with --degrees)",
     )
-    parser.add_argument("--goal", required=True, type=_floats(2, "--goal"), metavar="X,Y", help="goal (m)")
+    parser.add_argument(
+        "--goal", required=True, type=comma_floats(2, "--goal"), metavar="X,Y", help="goal (m)"
+    )
     parser.add_argument(
         "--via",
-        type=_floats(2, "--via"),
+        type=comma_floats(2, "--via"),
         action="append",
         metavar="X,Y",
         help="a point to pass before the goal (repeat, in order)",

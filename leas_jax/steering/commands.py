@@ -7,26 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
+from leas_jax.arguments import comma_floats
 from leas_jax.contacts.plan import MAX_GUIDE_POSES
 from leas_jax.errors import UsageError
-
-
-def _floats(count: int, name: str):
-    def parse(text: str):
-        try:
-            values = [float(v) for v in text.split(",")]
-        except ValueError:
-            raise argparse.ArgumentTypeError(
-                f"{name} expects {count} comma-separated numbers, got {text!r}"
-            ) from None
-        if len(values) != count or not np.all(np.isfinite(values)):
-            raise argparse.ArgumentTypeError(
-                f"{name} expects {count} finite comma-separated numbers, got {text!r}"
-            )
-        return values
-
-    return parse
-
 
 # Longest horizon `leas rollout` accepts: its guide (horizon + 1 poses) is one `leas plan` and
 # `leas show` accept (MAX_GUIDE_POSES, 2 000 s at the paper's 0.1 s step).
@@ -131,12 +114,12 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--start",
         required=True,
-        type=_floats(3, "--start"),
+        type=comma_floats(3, "--start"),
         metavar="X,Y,YAW",
         help="start position (m) and yaw (rad, or degrees with --degrees)",
     )
     parser.add_argument(
-        "--target", required=True, type=_floats(2, "--target"), metavar="X,Y", help="target (m)"
+        "--target", required=True, type=comma_floats(2, "--target"), metavar="X,Y", help="target (m)"
     )
     parser.add_argument(
         "--speed", type=_finite, default=0.0, help="initial speed along the heading (m/s, in [0, v_max])"

@@ -284,14 +284,11 @@ class _ProcessBackend(_QueuedBackend):
             )
             self._complete(
                 task,
-                PathResult(
-                    index=task.index,
-                    coverage=0.0,
-                    last_valid_index=-1,
-                    plan=None,
-                    error=f"TimeoutError: path {task.index} took longer than {self._task_timeout:g} s "
+                PathResult.failed(
+                    task.index,
+                    f"TimeoutError: path {task.index} took longer than {self._task_timeout:g} s "
                     f"(worker pid {pid} killed)",
-                    attempts=task.attempts,
+                    task.attempts,
                     seconds=time.monotonic() - worker.task_started,
                 ),
             )
@@ -320,14 +317,11 @@ class _ProcessBackend(_QueuedBackend):
             )
             self._complete(
                 task,
-                PathResult(
-                    index=task.index,
-                    coverage=0.0,
-                    last_valid_index=-1,
-                    plan=None,
-                    error=f"WorkerDied: contact worker (pid {pid}) {how} while planning path "
+                PathResult.failed(
+                    task.index,
+                    f"WorkerDied: contact worker (pid {pid}) {how} while planning path "
                     f"{task.index}, on each of {task.attempts} attempts",
-                    attempts=task.attempts,
+                    task.attempts,
                     seconds=time.monotonic() - worker.task_started,
                 ),
             )

@@ -244,13 +244,10 @@ class RayBackend(_QueuedBackend):
     def _error(self, task: _Task, started: float, error: str) -> None:
         self._complete(
             task,
-            PathResult(
-                index=task.index,
-                coverage=0.0,
-                last_valid_index=-1,
-                plan=None,
-                error=error,
-                attempts=task.attempts,
+            PathResult.failed(
+                task.index,
+                error,
+                task.attempts,
                 seconds=time.monotonic() - started,
             ),
         )
@@ -319,13 +316,10 @@ class RayBackend(_QueuedBackend):
                 )
             return
         except Exception as exc:  # noqa: BLE001 - e.g. the result could not be sent back
-            result = PathResult(
-                index=task.index,
-                coverage=0.0,
-                last_valid_index=-1,
-                plan=None,
-                error=f"path {task.index}: {_one_line(exc)}",
-                attempts=task.attempts,
+            result = PathResult.failed(
+                task.index,
+                f"path {task.index}: {_one_line(exc)}",
+                task.attempts,
                 seconds=time.monotonic() - started,
             )
         actor.tasks_done += 1

@@ -58,6 +58,22 @@ class PathResult:
     seconds: float = field(default=0.0, compare=False)
     traceback: str | None = field(default=None, compare=False, repr=False)
 
+    @classmethod
+    def failed(
+        cls, index: int, error: str, attempts: int, seconds: float = 0.0, traceback: str | None = None
+    ) -> PathResult:
+        """The result of a path that produced no plan (planner exception, worker death, timeout)."""
+        return cls(
+            index=index,
+            coverage=0.0,
+            last_valid_index=-1,
+            plan=None,
+            error=error,
+            attempts=attempts,
+            seconds=seconds,
+            traceback=traceback,
+        )
+
     @property
     def ok(self) -> bool:
         """True when the generator returned a plan (which may still cover little of the guide)."""
@@ -171,13 +187,10 @@ class PathRunner:
             coverage = float(plan.coverage)
             last_valid = int(plan.last_valid_index)
         except Exception as exc:
-            return PathResult(
-                index=index,
-                coverage=0.0,
-                last_valid_index=-1,
-                plan=None,
-                error=_one_line(exc),
-                attempts=attempts,
+            return PathResult.failed(
+                index,
+                _one_line(exc),
+                attempts,
                 seconds=time.perf_counter() - start,
                 traceback=traceback_module.format_exc(),
             )

@@ -29,25 +29,14 @@ CALLS = 3
 
 
 def _calls() -> list[float]:
-    """Wall time (s) of CALLS identical tiny `train` calls in this process (test_train's config)."""
-    import numpy as np
+    """Wall time (s) of CALLS identical tiny `train` calls in this process (the tests' config)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+    from training_helpers import gap_field, tiny_config
 
-    from leas_jax.env import heightfield_from_raster
-    from leas_jax.training import preset, train
+    from leas_jax.training import train
 
-    heights = np.zeros((301, 301), np.float32)
-    heights[200:230, :] = -2.0
-    field = heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0)
-    config = preset(
-        "smoke",
-        num_timesteps=64 * 8 * 2 * 3,
-        num_envs=64,
-        unroll_length=8,
-        num_minibatches=2,
-        num_epochs=2,
-        iterations_per_call=2,
-        checkpoint_every_s=0.0,
-    )
+    field = gap_field()
+    config = tiny_config()
     times = []
     with tempfile.TemporaryDirectory() as out:
         for k in range(CALLS):

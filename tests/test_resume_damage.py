@@ -7,34 +7,18 @@ import shutil
 import jax
 import numpy as np
 import pytest
+from training_helpers import gap_field, tiny_config
 
 from leas_jax.cli import main
-from leas_jax.env import heightfield_from_raster
 from leas_jax.errors import LeasError
 from leas_jax.terrain import TerrainError
-from leas_jax.training import checkpoint, load_policy, preset, records, train
+from leas_jax.training import checkpoint, load_policy, records, train
 from leas_jax.training.commands import config_from_args
-
-
-def tiny_config(**overrides):
-    """64 envs x 8 steps, 2 iterations per call, 3 calls, a checkpoint after every call."""
-    base = dict(
-        num_timesteps=64 * 8 * 2 * 3,
-        num_envs=64,
-        unroll_length=8,
-        num_minibatches=2,
-        num_epochs=2,
-        iterations_per_call=2,
-        checkpoint_every_s=0.0,
-    )
-    return preset("smoke", **{**base, **overrides})
 
 
 @pytest.fixture(scope="module")
 def field():
-    heights = np.zeros((301, 301), np.float32)
-    heights[200:230, :] = -2.0
-    return heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0)
+    return gap_field()
 
 
 @pytest.fixture(scope="module")

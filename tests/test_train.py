@@ -6,32 +6,17 @@ import pickle
 import jax
 import numpy as np
 import pytest
+from training_helpers import gap_field, tiny_config
 
-from leas_jax.env import EnvConfig, heightfield_from_raster
+from leas_jax.env import EnvConfig
 from leas_jax.errors import LeasError, UsageError
 from leas_jax.training import TrainConfig, checkpoint, load_policy, preset, train
 from leas_jax.training.config import TRAINING_ENV, TRAINING_REACHABILITY, pretraining_config
 
 
-def tiny_config(**overrides):
-    """A few-second config: 64 envs x 8 steps, 2 iterations per call."""
-    base = dict(
-        num_timesteps=64 * 8 * 2 * 3,
-        num_envs=64,
-        unroll_length=8,
-        num_minibatches=2,
-        num_epochs=2,
-        iterations_per_call=2,
-        checkpoint_every_s=0.0,
-    )
-    return preset("smoke", **{**base, **overrides})
-
-
 @pytest.fixture(scope="module")
 def field():
-    heights = np.zeros((301, 301), np.float32)
-    heights[200:230, :] = -2.0  # a gap to fall into
-    return heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0)
+    return gap_field()
 
 
 def test_presets_and_validation():

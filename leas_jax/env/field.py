@@ -11,8 +11,6 @@ terrain is `void_height` (the void the boxes stand over).
 
 from __future__ import annotations
 
-import dataclasses
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -20,6 +18,7 @@ from flax import struct
 from scipy import ndimage
 
 from leas_jax.env.config import EnvConfig, ReachabilityConfig
+from leas_jax.env.learned_weights import condition_params
 
 
 @struct.dataclass
@@ -297,36 +296,8 @@ def heightfield_from_raster(
         void_height=f32(void_height),
         spawn_xy=f32(spawn_xy),
         spawn_spacing=f32(spawn_spacing),
-        condition=_condition_params(config),
+        condition=condition_params(config),
     )
-
-
-def _condition_params(config: EnvConfig) -> dict:
-    """The learned condition's parameters when `config.condition` is "learned", else {} (host)."""
-    if config.condition == "cylinders":
-        return {}
-    if config.condition != "learned":
-        raise ValueError(f"EnvConfig.condition must be 'cylinders' or 'learned', got {config.condition!r}")
-    import json
-
-    from leas_jax.env.learned_feasibility import load_params, margin_count, resolve_weights
-
-    path = resolve_weights(config.learned_weights)
-    params, metadata = load_params(path)
-    features = len(params["grid"]) + 1 + margin_count(config.reachability)
-    if params["mean"].shape != (features,):
-        raise ValueError(
-            f"{path}: the learned condition reads {params['mean'].shape[0]} features, but its patch and "
-            f"the margins of EnvConfig.reachability give {features}: build the env with the "
-            "ReachabilityConfig it was fitted with"
-        )
-    fitted = metadata.get("reachability")
-    if fitted is not None and json.loads(fitted) != dataclasses.asdict(config.reachability):
-        raise ValueError(
-            f"{path}: the learned condition was fitted on the margins of another ReachabilityConfig "
-            f"({fitted}); build the env with that EnvConfig.reachability"
-        )
-    return params
 
 
 def heightfield_from_terrain(

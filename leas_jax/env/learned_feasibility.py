@@ -26,9 +26,6 @@ generator's walking verdicts.
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -37,6 +34,14 @@ from leas_jax.env import reachability
 from leas_jax.env.config import ReachabilityConfig
 from leas_jax.env.field import Heightfield, sample_nearest
 from leas_jax.env.kinematics import rotate_z
+from leas_jax.env.learned_weights import (  # noqa: F401 (the weights' file API, re-exported)
+    LAYER_KEYS,
+    LearnedParams,
+    load_params,
+    margin_count,
+    resolve_weights,
+    save_params,
+)
 
 # m, the local ground is the highest terrain point within this radius of the root (the pose
 # sampler's reference ground uses 0.15 m; grid points within it at a 0.08 m spacing: 9)
@@ -48,10 +53,6 @@ PATCH_Y = (-0.64, 0.64)
 PATCH_STEP = 0.08  # m; half the 0.04 m of the gradient-boosted reference: 238 points instead of 858
 CLIP = (-1.6, 0.4)  # m, relative heights (the arena's void is 2 m below its ground)
 HEIGHT_CLIP = (0.0, 2.0)  # m, height above the local ground
-LAYER_KEYS = ("w0", "b0", "w1", "b1", "w2", "b2")
-REPO_ROOT = Path(__file__).resolve().parents[2]
-
-LearnedParams = dict  # str -> jax.Array (see `init_params` for the keys and shapes)
 
 
 def patch_grid(x_range=PATCH_X, y_range=PATCH_Y, step: float = PATCH_STEP) -> np.ndarray:
@@ -160,17 +161,6 @@ def valid(
     return logit(params, field, pose, reach) >= params["threshold"]
 
 
-def margin_count(reach: ReachabilityConfig) -> int:
-    """M, the number of `reachability.margins` of a config."""
-    legs = 2 if reach.leg_forward == 0.0 else 4
-    return (
-        1
-        + 2 * legs
-        + (legs if reach.foothold_spread is not None else 0)
-        + (2 if reach.hand_radius is not None else 0)
-    )
-
-
 def init_params(
     key: jax.Array,
     hidden=(64, 32),
@@ -200,41 +190,3 @@ def init_params(
         params[f"w{layer}"] = jax.random.uniform(k, (n_in, n_out), minval=-limit, maxval=limit)
         params[f"b{layer}"] = jnp.zeros(n_out)
     return params
-
-
-def resolve_weights(path: str | Path) -> Path:
-    """A weights file as given if it exists, else relative to the repository root (the rule of
-    `training.config.resolve_data_path`, which the env cannot import: training imports env)."""
-    path = Path(path)
-    return path if path.exists() or path.is_absolute() else REPO_ROOT / path
-
-
-def save_params(path: str | Path, params: LearnedParams, **metadata) -> Path:
-    """Write params (and string metadata, e.g. the data key) to an .npz file, atomically."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
-    arrays = {k: np.asarray(v) for k, v in params.items()}
-    np.savez(tmp, **arrays, **{f"meta_{k}": np.asarray(str(v)) for k, v in metadata.items()})
-    os.replace(tmp, path)
-    return path
-
-
-def load_params(path: str | Path) -> tuple[LearnedParams, dict]:
-    """(params, metadata) of an .npz written by `save_params`.
-
-    Raises ValueError naming the file when it cannot be read or lacks a key.
-    """
-    path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as error:
-        raise ValueError(f"{path}: cannot read the learned condition's weights ({error})") from None
-    needed = ("grid", "clip", "mean", "std", "threshold", *LAYER_KEYS)
-    missing = [k for k in needed if k not in arrays]
-    if missing:
-        raise ValueError(f"{path}: not a learned condition's weights (missing {', '.join(missing)})")
-    params = {k: jnp.asarray(arrays[k], jnp.float32) for k in needed}
-    metadata = {k[len("meta_") :]: str(v) for k, v in arrays.items() if k.startswith("meta_")}
-    return params, metadata

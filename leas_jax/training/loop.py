@@ -336,7 +336,7 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
     resume from the saved PRNG key); only updated states are checkpointed.
     """
     from leas_jax.contacts.validation.pool import ValidationPool, available_cpus
-    from leas_jax.env.learned_feasibility import load_params
+    from leas_jax.env.learned_weights import load_params
     from leas_jax.training.planner import VerdictData, guides_of, make_planner_fns
 
     rollout, update = make_planner_fns(config)

@@ -366,7 +366,7 @@ class VerdictData:
         import os
         from pathlib import Path
 
-        from leas_jax.env.learned_feasibility import save_params
+        from leas_jax.env.learned_weights import save_params
 
         run_dir = Path(run_dir)
         save_params(run_dir / "condition.npz", field.condition, refreshes=self.refreshes)

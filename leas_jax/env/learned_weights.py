@@ -1,0 +1,96 @@
+"""The learned feasibility condition's weights: file format, location and the env's check.
+
+Host code (NumPy, files), apart from `learned_feasibility` (the jitted condition) so that
+the heightfield builder (`field.heightfield_from_terrain`) can load the weights without
+importing the condition, which reads the field.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from pathlib import Path
+
+import jax.numpy as jnp
+import numpy as np
+
+from leas_jax.env.config import EnvConfig, ReachabilityConfig
+
+LAYER_KEYS = ("w0", "b0", "w1", "b1", "w2", "b2")
+REPO_ROOT = Path(__file__).resolve().parents[2]
+
+LearnedParams = dict  # str -> jax.Array (see `learned_feasibility.init_params` for the keys and shapes)
+
+
+def margin_count(reach: ReachabilityConfig) -> int:
+    """M, the number of `reachability.margins` of a config."""
+    legs = 2 if reach.leg_forward == 0.0 else 4
+    return (
+        1
+        + 2 * legs
+        + (legs if reach.foothold_spread is not None else 0)
+        + (2 if reach.hand_radius is not None else 0)
+    )
+
+
+def resolve_weights(path: str | Path) -> Path:
+    """A weights file as given if it exists, else relative to the repository root (the rule of
+    `training.config.resolve_data_path`, which the env cannot import: training imports env)."""
+    path = Path(path)
+    return path if path.exists() or path.is_absolute() else REPO_ROOT / path
+
+
+def save_params(path: str | Path, params: LearnedParams, **metadata) -> Path:
+    """Write params (and string metadata, e.g. the data key) to an .npz file, atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
+    arrays = {k: np.asarray(v) for k, v in params.items()}
+    np.savez(tmp, **arrays, **{f"meta_{k}": np.asarray(str(v)) for k, v in metadata.items()})
+    os.replace(tmp, path)
+    return path
+
+
+def load_params(path: str | Path) -> tuple[LearnedParams, dict]:
+    """(params, metadata) of an .npz written by `save_params`.
+
+    Raises ValueError naming the file when it cannot be read or lacks a key.
+    """
+    path = Path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{path}: cannot read the learned condition's weights ({error})") from None
+    needed = ("grid", "clip", "mean", "std", "threshold", *LAYER_KEYS)
+    missing = [k for k in needed if k not in arrays]
+    if missing:
+        raise ValueError(f"{path}: not a learned condition's weights (missing {', '.join(missing)})")
+    params = {k: jnp.asarray(arrays[k], jnp.float32) for k in needed}
+    metadata = {k[len("meta_") :]: str(v) for k, v in arrays.items() if k.startswith("meta_")}
+    return params, metadata
+
+
+def condition_params(config: EnvConfig) -> dict:
+    """The learned condition's parameters when `config.condition` is "learned", else {} (host)."""
+    if config.condition == "cylinders":
+        return {}
+    if config.condition != "learned":
+        raise ValueError(f"EnvConfig.condition must be 'cylinders' or 'learned', got {config.condition!r}")
+    path = resolve_weights(config.learned_weights)
+    params, metadata = load_params(path)
+    features = len(params["grid"]) + 1 + margin_count(config.reachability)
+    if params["mean"].shape != (features,):
+        raise ValueError(
+            f"{path}: the learned condition reads {params['mean'].shape[0]} features, but its patch and "
+            f"the margins of EnvConfig.reachability give {features}: build the env with the "
+            "ReachabilityConfig it was fitted with"
+        )
+    fitted = metadata.get("reachability")
+    if fitted is not None and json.loads(fitted) != dataclasses.asdict(config.reachability):
+        raise ValueError(
+            f"{path}: the learned condition was fitted on the margins of another ReachabilityConfig "
+            f"({fitted}); build the env with that EnvConfig.reachability"
+        )
+    return params

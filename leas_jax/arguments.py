@@ -69,3 +69,18 @@ def add_ray_address_argument(parser, use: str) -> None:
         "ray://HOST:PORT (Ray client of a cluster), auto (the cluster this machine belongs "
         "to) or local (a new local Ray instance)",
     )
+
+
+def add_policy_start_arguments(parser) -> None:
+    """`--checkpoint`, `--allow-pickle`, `--terrain` and `--start X,Y,YAW`: the arguments of the
+    commands that walk a policy from a start on a terrain (`leas rollout`, `leas navigate`)."""
+    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.ckpt")
+    add_allow_pickle_argument(parser, "a policy")
+    parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain file (TOML)")
+    parser.add_argument(
+        "--start",
+        required=True,
+        type=comma_floats(3, "--start"),
+        metavar="X,Y,YAW",
+        help="start position (m) and yaw (rad, or degrees with --degrees)",
+    )

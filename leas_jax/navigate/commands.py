@@ -16,7 +16,7 @@ import math
 import sys
 from pathlib import Path
 
-from leas_jax.arguments import comma_floats
+from leas_jax.arguments import add_policy_start_arguments, comma_floats
 from leas_jax.errors import UsageError
 
 
@@ -108,8 +108,6 @@ def cmd_navigate(args) -> int:
 
 def register(subparsers) -> None:
     """Add `navigate` to the `leas` parser."""
-    from leas_jax.arguments import add_allow_pickle_argument
-
     parser = subparsers.add_parser(
         "navigate",
         help="verified contact plan from a start to a goal",
@@ -119,16 +117,7 @@ def register(subparsers) -> None:
         "contact plan (docs/design.md §6 format; `leas verify` checks it). Exit code 0: "
         "goal reached; 1: not reached (the best partial plan is written); 2: bad input.",
     )
-    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.ckpt")
-    add_allow_pickle_argument(parser, "a policy")
-    parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain file (TOML)")
-    parser.add_argument(
-        "--start",
-        required=True,
-        type=comma_floats(3, "--start"),
-        metavar="X,Y,YAW",
-        help="start position (m) and yaw (rad, or degrees with --degrees)",
-    )
+    add_policy_start_arguments(parser)
     parser.add_argument(
         "--goal", required=True, type=comma_floats(2, "--goal"), metavar="X,Y", help="goal (m)"
     )

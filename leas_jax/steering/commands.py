@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from leas_jax.arguments import comma_floats
+from leas_jax.arguments import add_policy_start_arguments, comma_floats
 from leas_jax.contacts.plan import MAX_GUIDE_POSES
 from leas_jax.errors import UsageError
 
@@ -100,24 +100,13 @@ def cmd_rollout(args) -> int:
 
 
 def register(subparsers) -> None:
-    from leas_jax.arguments import add_allow_pickle_argument
-
     parser = subparsers.add_parser(
         "rollout",
         help="guide path of a trained policy",
         description="Roll a trained LeaS policy from a start to a target; write the "
         "guide file (.npz, docs/design.md §6) and a top-down PNG beside it.",
     )
-    parser.add_argument("--checkpoint", required=True, metavar="DIR", help="run directory or policy.ckpt")
-    add_allow_pickle_argument(parser, "a policy")
-    parser.add_argument("--terrain", required=True, metavar="FILE", help="terrain TOML file")
-    parser.add_argument(
-        "--start",
-        required=True,
-        type=comma_floats(3, "--start"),
-        metavar="X,Y,YAW",
-        help="start position (m) and yaw (rad, or degrees with --degrees)",
-    )
+    add_policy_start_arguments(parser)
     parser.add_argument(
         "--target", required=True, type=comma_floats(2, "--target"), metavar="X,Y", help="target (m)"
     )

@@ -193,6 +193,12 @@ def test_translate_and_mixed_boxes(tmp_path):
     assert terrain.height_at([2.9, 1.9]) == terrain.void_height
     tops = sorted(round(float(s.vertices[:, 2].mean()), 6) for s in terrain.support_surfaces())
     assert tops == [0.0, 0.2]
+    # verify's collision messages name the object: the boxes first, then the mesh tiles
+    from leas_jax.contacts.robot.collision import terrain_collision
+    from leas_jax.contacts.verify import _terrain_object
+
+    names = [_terrain_object(terrain, b) for b in range(len(terrain_collision(terrain).shapes))]
+    assert names == ["terrain box 0", "terrain mesh tile 0"]
 
 
 def test_elevation_map_of_a_known_function(tmp_path):

@@ -191,7 +191,7 @@ def verify(plan, terrain=None) -> VerificationReport:
             fail.append((k, 3, f"joint {name} = {value:.4f} outside [{lo:.4f}, {hi:.4f}]"))
         rot, pos = robot.placements_pinocchio(talos, q)
         for g, b in robot.terrain_contacts(rot, pos, objects, first_only=False):
-            fail.append((k, 3, f"{robot.names[g]} collides with terrain box {b}"))
+            fail.append((k, 3, f"{robot.names[g]} collides with {_terrain_object(terrain, b)}"))
         for ga, gb in robot.self_contacts(rot, pos, first_only=False):
             fail.append((k, 3, f"{robot.names[ga]} collides with {robot.names[gb]}"))
 
@@ -310,3 +310,9 @@ def _same_placement(row_a: np.ndarray, row_b: np.ndarray) -> bool:
         return False
     diff = matrix_from_quat_xyzw(row_a[3:]) - matrix_from_quat_xyzw(row_b[3:])
     return bool(np.max(np.abs(diff)) <= SAME_PLACEMENT_TOL)
+
+
+def _terrain_object(terrain, index: int) -> str:
+    """Name of collision object `index` of `terrain_collision(terrain)`: its boxes, then mesh tiles."""
+    boxes = len(terrain.boxes)
+    return f"terrain box {index}" if index < boxes else f"terrain mesh tile {index - boxes}"

@@ -198,7 +198,8 @@ def test_translate_and_mixed_boxes(tmp_path):
     from leas_jax.contacts.verify import _terrain_object
 
     names = [_terrain_object(terrain, b) for b in range(len(terrain_collision(terrain).shapes))]
-    assert names == ["terrain box 0", "terrain mesh tile 0"]
+    # the block straddles x = 2 and y = 1, the corners of four 1 m tiles
+    assert names == ["terrain box 0"] + [f"terrain mesh tile {k}" for k in range(4)]
 
 
 def test_elevation_map_of_a_known_function(tmp_path):

@@ -167,32 +167,15 @@ def build(jobs, terrain, field, cells, n_starts: int, base, env):
 
 
 def judge(terrain, trajectories, timestep: float, workers: int, stride: int | None) -> None:
-    """Fill every trajectory's outcome: `evaluate.validate` (stride None: the generator's
-    defaults), else one pool whose generator plans every `stride`-th guide pose."""
-    import concurrent.futures
-
-    from leas_jax.contacts import GeneratorConfig, ValidationPool
-    from leas_jax.eval import metrics
+    """Fill every trajectory's outcome with `evaluate.validate`: the generator's defaults
+    (stride None), else a generator that plans every `stride`-th guide pose."""
+    from leas_jax.contacts import GeneratorConfig
     from leas_jax.eval.evaluate import validate
 
-    if stride is None:
-        validate(terrain, trajectories, timestep, workers, progress=True, desc="table II baselines")
-        return
-    target = np.asarray(terrain.scenario.target, np.float64)
-    config = GeneratorConfig(stride=stride)
-    with ValidationPool(terrain, workers=workers, config=config, return_plans=True) as pool:
-        futures = {pool.submit([t.guide], timestep): t for t in trajectories}
-        for future in concurrent.futures.as_completed(futures):
-            t = futures[future]
-            (result,) = future.result()
-            t.outcome = metrics.outcome(
-                t.guide,
-                target,
-                result.coverage,
-                result.last_valid_index,
-                plan=result.plan,
-                error=result.error,
-            )
+    config = None if stride is None else GeneratorConfig(stride=stride)
+    validate(
+        terrain, trajectories, timestep, workers, progress=True, desc="table II baselines", config=config
+    )
 
 
 def figure(report: dict, path: Path) -> None:

@@ -389,11 +389,13 @@ def validate(
     progress: bool = True,
     desc: str = "contact planning",
     address: str | None = None,
+    config=None,
 ) -> None:
     """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`
     (trajectories that arrive with one, navigate's, are left as they are). Host-only.
 
     `address`: a Ray cluster for the pool (`ValidationPool(address=...)`); None for local processes.
+    `config`: the generator's `GeneratorConfig` (None: its defaults).
     """
     from tqdm.auto import tqdm
 
@@ -407,7 +409,7 @@ def validate(
             t.outcome = metrics.outcome(None, target, 0.0, -1, error=t.error or "no guide")
     if not todo:
         return
-    with ValidationPool(terrain, workers=workers, address=address, return_plans=True) as pool:
+    with ValidationPool(terrain, workers=workers, address=address, config=config, return_plans=True) as pool:
         futures = {pool.submit([t.guide], timestep): t for t in todo}
         with tqdm(total=len(todo), desc=desc, disable=not progress, leave=False) as bar:
             for future in concurrent.futures.as_completed(futures):

@@ -13,7 +13,7 @@ that starts at the pose along its yaw. Two pose sets:
 Labels are cached in .cache/feasibility_<set>_<key>.npz at the repository root, where
 <key> hashes everything a label depends on (`dataset_key`): the terrain file's text,
 the generator's settings (`GeneratorConfig`), the generator's sources
-(leas_jax/contacts/**/*.py) and the walking truth's guide. A change to any of them gives
+(leas_jax/contacts/**/*.py and leas_jax/terrain/**/*.py) and the walking truth's guide. A change to any of them gives
 another key, so the labels are rebuilt. Labels are computed in chunks and the cache is
 rewritten (atomically) after each one: an interrupted build resumes where it stopped.
 Host-only.
@@ -40,23 +40,24 @@ CACHE = REPO / ".cache"
 CHUNK = 50  # poses per labelling task: a cache write every CHUNK * workers poses
 
 
-def dataset_key(
-    terrain_text: str, generator_config, sources_root: Path = REPO / "leas_jax" / "contacts"
-) -> str:
+def dataset_key(terrain_text: str, generator_config, sources_root: Path | None = None) -> str:
     """sha256 (hex) of what a walking-truth label depends on.
 
     Args:
         terrain_text: the terrain file's text.
         generator_config: the `GeneratorConfig` the labels are made with (its repr holds every field).
-        sources_root: the generator's package; every .py file below it is hashed (name and bytes).
+        sources_root: a folder whose .py files stand for the generator's code (None: the
+            package's, `spawns.GENERATOR_SOURCES`: the generator and the terrain code).
     """
+    from leas_jax.feasibility.spawns import GENERATOR_SOURCES, generator_code_digest
+
     digest = hashlib.sha256()
     digest.update(f"walking {rc.WALK_POSES} {rc.WALK_SPEED} {rc.WALK_TIMESTEP}\n".encode())
     digest.update(repr(generator_config).encode())
     digest.update(terrain_text.encode())
-    for path in sorted(sources_root.rglob("*.py")):
-        digest.update(str(path.relative_to(sources_root)).encode())
-        digest.update(path.read_bytes())
+    digest.update(
+        generator_code_digest(GENERATOR_SOURCES if sources_root is None else (sources_root,)).encode()
+    )
     return digest.hexdigest()
 
 

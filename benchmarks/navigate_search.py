@@ -17,21 +17,10 @@ Writes <out>/navigate_search.json.
 from __future__ import annotations
 
 import argparse
-import math
 import time
 
 import numpy as np
-from common import add_out_argument, load_average, save
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95 % Wilson score interval of a proportion k / n, in %."""
-    if n == 0:
-        return (float("nan"), float("nan"))
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return (100 * (centre - half), 100 * (centre + half))
+from common import add_out_argument, load_average, save, wilson
 
 
 def summary(found: list[bool], seconds: list[float]) -> dict:
@@ -40,7 +29,7 @@ def summary(found: list[bool], seconds: list[float]) -> dict:
         "n": n,
         "found": k,
         "percent": 100.0 * k / n if n else float("nan"),
-        "wilson95": wilson(k, n),
+        "wilson95": tuple(100 * x for x in wilson(k, n)),
         "median_s": float(np.median(seconds)),
         "p95_s": float(np.percentile(seconds, 95)),
     }

@@ -40,7 +40,6 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
 import json  # noqa: E402
-import math  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -50,6 +49,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import reachability_calibration as rc  # noqa: E402
+from common import wilson  # noqa: E402
 
 TARGET_SENSITIVITY = rc.TARGET_SENSITIVITY
 HEIGHTMAP_STEP = 0.04  # m, spacing of the learned reference's heightmap
@@ -58,16 +58,6 @@ HEIGHTMAP_Y = (-0.64, 0.64)  # m, root frame: past the hand disks (0.45 + 0.13 m
 HEIGHTMAP_CLIP = (-1.6, 0.4)  # m, heights relative to the root (the void is -2 m below the arena)
 CALIBRATION_SEED = 0  # benchmarks/reachability_calibration.py's default --seed
 THRESHOLD_SPLIT = 0.1  # share of the fitting poses kept aside to set the classifier's threshold
-
-
-def wilson(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
-    """95 % (z = 1.96) Wilson score interval of a proportion; (nan, nan) without trials."""
-    if trials == 0:
-        return math.nan, math.nan
-    p = successes / trials
-    centre = (p + z * z / (2 * trials)) / (1 + z * z / trials)
-    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / (1 + z * z / trials)
-    return centre - half, centre + half
 
 
 def rates(predicted: np.ndarray, truth: np.ndarray) -> dict:

@@ -50,8 +50,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from common import load_average, provenance  # noqa: E402
-from reachability_validation import wilson  # noqa: E402
+from common import (  # noqa: E402
+    load_average,
+    provenance,
+    wilson,  # noqa: E402
+)
 
 from leas_jax.errors import UsageError  # noqa: E402
 

@@ -67,8 +67,8 @@ def test_every_committed_terrain_file_is_known():
 
 @pytest.mark.parametrize("name", COMMITTED)
 def test_every_box_top_is_a_support_surface(name):
-    """The generators never cover the centre of a box's top face with another box, so no
-    support surface is lost (`support_surfaces` drops faces buried at their centre)."""
+    """The generators never cover a box's top face whole with other boxes, so no support
+    surface is lost (`support_surfaces` drops faces buried whole)."""
     terrain = load_terrain(TERRAINS / f"{name}.toml")
     surfaces = terrain.support_surfaces()
     assert sorted(s.box_index for s in surfaces) == list(range(len(terrain.boxes)))

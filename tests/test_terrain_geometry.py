@@ -260,14 +260,20 @@ def test_side_face_of_a_rolled_box_is_a_support_surface():
     np.testing.assert_allclose(signed_area_normal(surface.vertices), [0, 0, 0.4 * 0.3], atol=1e-12)
 
 
-def test_faces_buried_under_another_box_are_left_out():
+def test_only_faces_buried_whole_under_other_boxes_are_left_out():
     ground = Box([0.5, 0.5, -0.1], [1.0, 1.0, 0.2])
-    over_centre = Box([0.5, 0.5, 0.05], [0.3, 0.3, 0.1])  # rests on the ground's centre
+    over_centre = Box([0.5, 0.5, 0.05], [0.3, 0.3, 0.1])  # a pillar on the ground's centre
     off_centre = Box([0.15, 0.15, 0.05], [0.2, 0.2, 0.1])
-    covered = make_terrain([ground, over_centre]).support_surfaces()
-    assert [s.box_index for s in covered] == [1]
-    free = make_terrain([ground, off_centre]).support_surfaces()
-    assert [s.box_index for s in free] == [0, 1]
+    over_all = Box([0.5, 0.5, 0.05], [1.2, 1.2, 0.1])  # covers the whole ground face
+    halves = [Box([0.25, 0.5, 0.05], [0.5, 1.0, 0.1]), Box([0.75, 0.5, 0.05], [0.5, 1.0, 0.1])]
+    for covering, kept in (
+        ([over_centre], [0, 1]),
+        ([off_centre], [0, 1]),
+        ([over_all], [1]),
+        (halves, [1, 2]),
+    ):
+        surfaces = make_terrain([ground, *covering]).support_surfaces()
+        assert [s.box_index for s in surfaces] == kept
     with pytest.raises(TerrainError):
         make_terrain([ground]).support_surfaces(mu=0.0)
 

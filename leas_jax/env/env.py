@@ -155,14 +155,18 @@ class LeasEnv(Env):
         count = self.field.spawn_xy.shape[0]
         idx = jnp.minimum((cand[:, 0] * count).astype(jnp.int32), count - 1)
         jitter = (cand[:, 1:3] - 0.5) * self.field.spawn_spacing
-        # the last candidate is the spawn point itself (masks, not scatters: scatters are slow on CPU)
+        # the last candidate is the spawn point itself (masks, not scatters: scatters are slow
+        # on CPU), and so is every verified start pose (a spawn with its own yaw)
         last = jnp.arange(n) == n - 1
-        xy = self.field.spawn_xy[idx] + jnp.where(last[:, None], 0.0, jitter)
-        yaw = (2.0 * cand[:, 3] - 1.0) * jnp.pi
+        spawn_yaw = self.field.spawn_yaw[idx]
+        verified = ~jnp.isnan(spawn_yaw)
+        exact = last | verified
+        xy = self.field.spawn_xy[idx] + jnp.where(exact[:, None], 0.0, jitter)
+        yaw = jnp.where(verified, spawn_yaw, (2.0 * cand[:, 3] - 1.0) * jnp.pi)
         z = sample_bilinear(self.field, xy) + cfg.nominal_root_height
         poses = jnp.concatenate([xy, z[:, None], yaw[:, None]], axis=1)
         ok = jax.vmap(lambda p: condition.valid(self.field, p, cfg))(poses)
-        ok = ok | last  # spawn points are valid for every yaw by construction
+        ok = ok | exact  # spawn points are valid for every yaw by construction, verified poses as they are
         pose = poses[jnp.argmax(ok)]
         target_angle = (2.0 * target_u - 1.0) * jnp.pi
         return self._root(

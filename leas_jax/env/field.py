@@ -40,8 +40,11 @@ class Heightfield:
         origin: [2] world (x, y) of `heights[0, 0]`.
         resolution: [] cell size (m).
         void_height: [] height outside the grid.
-        spawn_xy: [S, 2] world (x, y) of grid points where a root at nominal
-            height is valid for every yaw; resets draw around them.
+        spawn_xy: [S, 2] world (x, y) of the reset positions: grid points where a root at
+            nominal height is valid for every yaw (resets draw around them), or, where
+            `spawn_yaw` is set, positions of verified start poses (resets use them as they are).
+        spawn_yaw: [S] yaw (rad, world) of each verified start pose; NaN where any yaw is
+            valid (`EnvConfig.spawns`: "condition" gives NaN everywhere, "generator" none).
         spawn_spacing: [] spacing of the spawn candidates (m); resets jitter within it.
         condition: the learned feasibility condition's parameters
             (`learned_feasibility.LearnedParams`) when `EnvConfig.condition` is "learned",
@@ -58,6 +61,7 @@ class Heightfield:
     resolution: jax.Array
     void_height: jax.Array
     spawn_xy: jax.Array
+    spawn_yaw: jax.Array
     spawn_spacing: jax.Array
     condition: dict = struct.field(default_factory=dict)
 
@@ -295,6 +299,7 @@ def heightfield_from_raster(
         resolution=f32(resolution),
         void_height=f32(void_height),
         spawn_xy=f32(spawn_xy),
+        spawn_yaw=f32(np.full(len(spawn_xy), np.nan)),
         spawn_spacing=f32(spawn_spacing),
         condition=condition_params(config),
     )

@@ -59,6 +59,7 @@ def arena_check(
         failure_breakdown,
         ground_speed,
     )
+    from leas_jax.feasibility.spawns import arena_field
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
@@ -71,7 +72,7 @@ def arena_check(
     policy = load_policy(checkpoint)
     env = policy.config.env
     arena = load_terrain(terrain_file if terrain_file is not None else policy.config.terrain_path())
-    field = heightfield_from_terrain(arena, env)
+    field = arena_field(arena, env)
     ground = load_terrain(resolve_data_path("terrains/eval_ground.toml"))
     speed = ground_speed(policy, ground, heightfield_from_terrain(ground, env), n=ground_episodes, seed=2)
     report = {

@@ -68,6 +68,7 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
         failure_breakdown,
         ground_speed,
     )
+    from leas_jax.feasibility.spawns import arena_field
     from leas_jax.plotting import plot_paths
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import resolve_data_path
@@ -79,7 +80,7 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
     if records:
         plot_curves(records, GEOMETRIC_PANELS, out / "learning_curves.png")
     arena = load_terrain(config.terrain_path())
-    field = heightfield_from_terrain(arena, config.env)
+    field = arena_field(arena, config.env)
     episodes = arena_episodes(policy, field, n=n_episodes, seed=1)
     failures = failure_breakdown(field, episodes, config.env.reachability)
     show = min(24, n_episodes)
@@ -152,8 +153,8 @@ def _planner_section(
     geometric_dir: Path, planner_dir: Path, out: Path, compare_starts: int, workers: int
 ) -> tuple[list[str], dict]:
     """Markdown lines of the planner phase: curves and coverage before/after over the same starts."""
-    from leas_jax.env import heightfield_from_terrain
     from leas_jax.eval.planner_compare import arena_coverage, scenario_coverage
+    from leas_jax.feasibility.spawns import arena_field
     from leas_jax.terrain import load_terrain
     from leas_jax.training.policy import load_policy
 
@@ -175,7 +176,7 @@ def _planner_section(
             "training arena": arena_coverage(
                 policy,
                 arena,
-                heightfield_from_terrain(arena, policy.config.env),
+                arena_field(arena, policy.config.env, workers=workers),
                 n=compare_starts,
                 workers=workers,
             )

@@ -23,9 +23,13 @@ _EDGE_TOL = 1e-7  # m
 # Number of raster points evaluated at once per box (bounds the temporary arrays
 # to a few tens of MB whatever the box size).
 _CHUNK_POINTS = 1 << 20
-# A face is buried if a point this far above its centre (along its normal) lies
-# inside another box: a step resting on the ground covers the ground face there.
+# A face is buried if every probe point, this far above it along its normal, lies inside
+# another box: a step covering the whole ground face. The probes are a grid of
+# _BURIED_GRID x _BURIED_GRID points from 5 % to 95 % of the face's sides, so a pillar
+# standing on the middle of a slab no longer hides the whole slab (the generator's
+# `surfaces.uncovered` check keeps soles off the covered part of a face it keeps).
 _BURIED_PROBE = 1e-3  # m
+_BURIED_GRID = 5
 
 
 def _frozen_array(value, shape: tuple[int, ...]) -> np.ndarray:
@@ -245,6 +249,14 @@ class SupportSurface:
         object.__setattr__(self, "normal", _frozen_array(self.normal, (3,)))
 
 
+def _face_probes(corners: np.ndarray) -> np.ndarray:
+    """[_BURIED_GRID ** 2, 3] points of a rectangular face with corners [4, 3] (`face_polygon`'s
+    order), from 5 % to 95 % of its sides."""
+    s, t = np.meshgrid(*(np.linspace(0.05, 0.95, _BURIED_GRID),) * 2, indexing="ij")
+    s, t = s.reshape(-1, 1), t.reshape(-1, 1)
+    return corners[2] + s * (corners[3] - corners[2]) + t * (corners[1] - corners[2])
+
+
 def face_polygon(box: Box, axis: int, sign: int) -> tuple[np.ndarray, np.ndarray]:
     """Corners and outward normal of one face of a box.
 
@@ -378,8 +390,9 @@ class Terrain:
         """Faces a foot may rest on: outward normal within the friction cone.
 
         A box face qualifies when the angle between its outward normal and +z is at most
-        atan(mu). Faces whose centre is covered by another box (a point 1 mm above the
-        centre lies inside it) are left out; partly covered faces are returned whole.
+        atan(mu). Faces covered by other boxes (a 5 x 5 grid of points 1 mm above the
+        face, `_face_probes`, all inside them) are left out; partly covered faces are
+        returned whole.
         Meshes give convex polygons of adjacent coplanar triangles within the cone
         (`leas_jax.terrain.mesh.support_polygons`).
 
@@ -406,10 +419,11 @@ class Terrain:
         if not faces:
             return meshes
         owner = np.array([f[0] for f in faces])
-        probes = np.array([f[1].mean(axis=0) + _BURIED_PROBE * f[2] for f in faces])  # [F, 3]
-        buried = np.zeros(len(faces), dtype=bool)
+        probes = np.stack([_face_probes(corners) + _BURIED_PROBE * normal for _, corners, normal in faces])
+        covered = np.zeros(probes.shape[:2], dtype=bool)  # [F, P]
         for index, box in enumerate(self.boxes):
-            buried |= box.contains(probes) & (owner != index)
+            covered |= box.contains(probes.reshape(-1, 3)).reshape(covered.shape) & (owner != index)[:, None]
+        buried = covered.all(axis=1)
         surfaces = [
             SupportSurface(corners, normal, index)
             for (index, corners, normal), hidden in zip(faces, buried)

@@ -77,6 +77,15 @@ def add_training_arguments(parser) -> None:
         "walking verdicts; in planner mode refreshed on the generator's verdicts on the policy's "
         "guides: docs/results/2026-12-01-feasibility)",
     )
+    parser.add_argument(
+        "--spawns",
+        choices=["condition", "generator"],
+        default="condition",
+        help="where random resets start: condition (the default: near grid points where the "
+        "condition's cylinders hold for every yaw) or generator (at poses where the Talos contact "
+        "generator stands in double support, verified once per terrain and cached; a few minutes "
+        "on the training arena)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
         "--checkpoint-every",
@@ -128,6 +137,8 @@ def config_from_args(args):
         config = dataclasses.replace(
             config, env=learned_condition_env(config.env), condition_refresh_every=refresh
         )
+    if args.spawns != config.env.spawns:
+        config = dataclasses.replace(config, env=dataclasses.replace(config.env, spawns=args.spawns))
     return config
 
 

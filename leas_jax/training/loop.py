@@ -250,14 +250,14 @@ def train(
 
     Host function: runs jitted iterations, writes files; not jittable.
     """
-    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.feasibility.spawns import arena_field
     from leas_jax.terrain import load_terrain
 
     config.validate()
     # everything that can fail on bad input is checked before anything is written
     terrain = load_terrain(config.terrain_path())
     if field is None:
-        field = heightfield_from_terrain(terrain, config.env)
+        field = arena_field(terrain, config.env, workers=workers, progress=progress)
     run_dir = Path(out)
     if run_dir.exists() and not run_dir.is_dir():
         raise UsageError(f"--out {run_dir}: exists and is not a directory")

@@ -1,0 +1,238 @@
+"""Where and why the contact generator stops on a policy's own arena guides.
+
+For a trained policy (deterministic), run `--starts` episodes from the env's own random
+resets on its training arena (`leas_jax.eval.geometric.arena_episodes`, 400 steps), plan
+every guide with the contact generator, and for each guide it does not cover fully
+describe the planning pose where it stopped (the first one after `last_valid_index`):
+
+- the arena cell it lies in, by kind (the `# cell (i, j) [...]: kind` comments that
+  `leas terrain generate` writes; "unknown" on other terrains);
+- the guide's speed and yaw rate over the 0.5 s before it;
+- with `--what-if`, whether the same guide, re-planned with each of a few other generator
+  settings (`what_if_configs`) or slowed down, passes it.
+
+`--spawns generator` starts the episodes at poses where the generator stands
+(`EnvConfig.spawns`); the default keeps the policy's own setting. Writes
+guide_failures.json and guide_failures.md into --out.
+
+    python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 64 --workers 2 --what-if
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import re
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+CELL_COMMENT = re.compile(
+    r"#\s*cell \((\d+), (\d+)\) \[([-\d.]+), ([-\d.]+)\] x \[([-\d.]+), ([-\d.]+)\]:\s*(\S+)"
+)
+WINDOW_S = 0.5  # s of guide before the failing pose whose speed and yaw rate are reported
+
+
+def cell_kinds(terrain_text: str) -> list[tuple[float, float, float, float, str]]:
+    """The arena's cells [(x0, x1, y0, y1, kind)] from its generator comments ([] when none)."""
+    return [
+        (float(m[3]), float(m[4]), float(m[5]), float(m[6]), m[7])
+        for m in CELL_COMMENT.finditer(terrain_text)
+    ]
+
+
+def kind_at(cells, xy) -> str:
+    """Kind of the cell holding world point `xy` [2] ("unknown" outside every cell)."""
+    for x0, x1, y0, y1, kind in cells:
+        if x0 <= xy[0] < x1 and y0 <= xy[1] < y1:
+            return kind
+    return "unknown"
+
+
+def failing_index(last_valid: int, length: int, stride: int) -> int:
+    """Guide index of the planning pose the generator could not pass (see ContactGenerator.plan)."""
+    return min(max(last_valid, 0) + stride, length - 1) if last_valid >= 0 else 0
+
+
+def motion_before(guide: np.ndarray, index: int, timestep: float) -> tuple[float, float]:
+    """(speed m/s, |yaw rate| rad/s) of a [T, 4] guide over the WINDOW_S before `index`."""
+    back = max(index - round(WINDOW_S / timestep), 0)
+    if back == index:
+        return 0.0, 0.0
+    dt = (index - back) * timestep
+    speed = float(np.linalg.norm(guide[index, :2] - guide[back, :2]) / dt)
+    yaw = np.unwrap(guide[back : index + 1, 3])
+    return speed, float(abs(yaw[-1] - yaw[0]) / dt)
+
+
+def what_if_configs(base) -> dict:
+    """Generator settings tried on the failed guides, each one change from `base`."""
+    return {
+        "max_foot_yaw=0.8": dataclasses.replace(base, max_foot_yaw=0.8),
+        "max_steps_per_pose=4": dataclasses.replace(base, max_steps_per_pose=4),
+        "max_candidates=24": dataclasses.replace(base, max_candidates=24),
+        "max_root_offset_xy=0.20": dataclasses.replace(base, max_root_offset_xy=0.20),
+    }
+
+
+def slowed(guide: np.ndarray, factor: int) -> np.ndarray:
+    """The same path at 1/factor of its speed: [T, 4] -> [(T - 1) * factor + 1, 4], linear in x, y, z, yaw."""
+    t = np.arange(len(guide), dtype=np.float64)
+    fine = np.linspace(0.0, len(guide) - 1, (len(guide) - 1) * factor + 1)
+    yaw = np.unwrap(guide[:, 3])
+    return np.stack([np.interp(fine, t, c) for c in (guide[:, 0], guide[:, 1], guide[:, 2], yaw)], axis=1)
+
+
+def main(argv=None) -> dict:
+    from common import add_out_argument, load_average, save, wilson
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--policy", default="checkpoints/leas_talos", help="run directory or policy.ckpt")
+    parser.add_argument("--starts", type=int, default=64)
+    parser.add_argument("--seed", type=int, default=0, help="evaluation seed of the resets")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--spawns", choices=["policy", "condition", "generator"], default="policy")
+    parser.add_argument(
+        "--what-if", action="store_true", help="re-plan the failed guides with other settings"
+    )
+    parser.add_argument(
+        "--slow-factor", type=int, default=2, help="what-if: the failed guides this much slower"
+    )
+    add_out_argument(parser)
+    args = parser.parse_args(argv)
+    load_before = load_average()
+
+    from leas_jax.contacts.planner.config import GeneratorConfig
+    from leas_jax.contacts.validation.pool import validate_paths
+    from leas_jax.eval.geometric import arena_episodes
+    from leas_jax.feasibility.spawns import arena_field
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.policy import load_policy
+
+    policy = load_policy(args.policy)
+    env = policy.config.env
+    if args.spawns != "policy":
+        env = dataclasses.replace(env, spawns=args.spawns)
+        policy = dataclasses.replace(policy, config=dataclasses.replace(policy.config, env=env))
+    arena = load_terrain(policy.config.terrain_path())
+    field = arena_field(arena, env, workers=args.workers)
+    episodes = arena_episodes(policy, field, n=args.starts, seed=args.seed)
+    guides = [episodes.poses[k, : episodes.lengths[k]].astype(np.float64) for k in range(args.starts)]
+    base = GeneratorConfig()
+    results = validate_paths(
+        arena, guides, env.timestep, workers=args.workers, config=base, return_plans=False
+    )
+    coverage = np.array([r.coverage for r in results])
+    failed = [k for k in range(args.starts) if coverage[k] < 1.0]
+    cells = cell_kinds(arena.text)
+    failures = []
+    for k in failed:
+        index = failing_index(results[k].last_valid_index, len(guides[k]), base.stride)
+        speed, yaw_rate = motion_before(guides[k], index, env.timestep)
+        failures.append(
+            {
+                "start": k,
+                "coverage": float(coverage[k]),
+                "index": index,
+                "pose": guides[k][index].tolist(),
+                "cell": kind_at(cells, guides[k][index, :2]),
+                "speed": speed,
+                "yaw_rate": yaw_rate,
+            }
+        )
+    what_if = {}
+    failed_guides = [guides[k] for k in failed]
+    if args.what_if and failed:
+        for name, config in what_if_configs(base).items():
+            redo = validate_paths(
+                arena, failed_guides, env.timestep, workers=args.workers, config=config, return_plans=False
+            )
+            what_if[name] = [float(r.coverage) for r in redo]
+        redo = validate_paths(
+            arena,
+            [slowed(g, args.slow_factor) for g in failed_guides],
+            env.timestep,
+            workers=args.workers,
+            config=base,
+            return_plans=False,
+        )
+        what_if[f"guide {args.slow_factor}x slower"] = [float(r.coverage) for r in redo]
+    full = int(np.sum(coverage >= 1.0))
+    start = episodes.poses[:, 0, :2]
+    final = episodes.poses[np.arange(args.starts), episodes.lengths - 1, :2]
+    moved = np.linalg.norm(final - start, axis=1)
+    report = {
+        "policy": str(args.policy),
+        "terrain": arena.name,
+        "spawns": env.spawns,
+        "starts": args.starts,
+        "seed": args.seed,
+        "full_coverage": full / args.starts,
+        "full_coverage_95ci": list(wilson(full, args.starts)),
+        "mean_coverage": float(coverage.mean()),
+        "failed_at_first_pose": int(sum(f["index"] == 0 for f in failures)),
+        "mean_progress_m": float(episodes.mean_progress),
+        "mean_displacement_m": float(moved.mean()),
+        "valid_fraction": float(episodes.valid_fraction),
+        "failures": failures,
+        "failures_by_cell": dict(Counter(f["cell"] for f in failures).most_common()),
+        "cells_visited": dict(
+            Counter(kind_at(cells, p[:2]) for g in guides for p in g[:: base.stride]).most_common()
+        ),
+        "what_if": {
+            name: {
+                "fully_covered_now": int(sum(c >= 1.0 for c in cov)),
+                "of_failed": len(failed),
+                "mean_coverage_gain": float(np.mean(np.array(cov) - coverage[failed])) if failed else 0.0,
+            }
+            for name, cov in what_if.items()
+        },
+    }
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "guide_failures.md").write_text(markdown(report))
+    save("guide_failures", report, load_before, out)
+    print(markdown(report))
+    return report
+
+
+def markdown(report: dict) -> str:
+    """The report's tables: failures by cell kind, motion at the failure, the what-ifs."""
+    lo, hi = report["full_coverage_95ci"]
+    lines = [
+        f"Policy {report['policy']} on {report['terrain']}, spawns {report['spawns']}, "
+        f"{report['starts']} starts (seed {report['seed']}): "
+        f"{100 * report['full_coverage']:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}] of guides fully covered, "
+        f"mean coverage {100 * report['mean_coverage']:.1f} %; {report['failed_at_first_pose']} guides "
+        f"fail at their first pose; mean progress along the target direction "
+        f"{report['mean_progress_m']:.2f} m; episodes without an invalid pose "
+        f"{100 * report['valid_fraction']:.1f} %.",
+        "",
+        "| cell kind at the failure | failed guides | planning poses visited |",
+        "|---|---|---|",
+    ]
+    for kind, count in report["failures_by_cell"].items():
+        lines.append(f"| {kind} | {count} | {report['cells_visited'].get(kind, 0)} |")
+    if report["failures"]:
+        speed = np.array([f["speed"] for f in report["failures"]])
+        yaw = np.array([f["yaw_rate"] for f in report["failures"]])
+        lines += [
+            "",
+            f"Before the failure (0.5 s): speed median {np.median(speed):.3f} m/s (max {speed.max():.3f}), "
+            f"|yaw rate| median {np.degrees(np.median(yaw)):.1f} deg/s (max {np.degrees(yaw.max()):.1f}).",
+        ]
+    if report["what_if"]:
+        lines += ["", "| what if | failed guides now fully covered | mean coverage gain |", "|---|---|---|"]
+    for name, entry in report["what_if"].items():
+        lines.append(
+            f"| {name} | {entry['fully_covered_now']} / {entry['of_failed']} | {100 * entry['mean_coverage_gain']:+.1f} pts |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,180 @@
+"""Start poses the contact generator can stand on: the resets of `EnvConfig(spawns="generator")`.
+
+The env's own spawn points (`leas_jax.env.field`) are grid points where the reachability
+cylinders hold for every yaw. The contact generator disagrees at some of them: on the
+training arena 8 % of them, at a random yaw, are poses where Talos cannot stand in double
+support (feet on faces, leg IK, collisions, equilibrium), so guides starting there fail at
+their first pose whatever the policy does. `verified_spawns` draws `EnvConfig.spawn_yaws`
+random yaws at every spawn point, asks the generator (`ContactGenerator.double_support`, as
+the first pose of a one-pose guide through `ValidationPool`), and keeps the poses it accepts
+as the field's (spawn_xy, spawn_yaw) table; resets then start exactly at one of them.
+
+Host only (the generator is not jittable). Verdicts are cached in `cache_dir()` under a key
+of everything they depend on (terrain text, generator settings and code, the env's spawn
+settings), written chunk by chunk: an interrupted build resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import io
+from pathlib import Path
+
+import numpy as np
+
+SPAWN_MODES = ("condition", "generator")
+CHUNK = 2000  # poses per pool batch: a cache write and a progress-bar update each
+_FORMAT = "leas-verified-spawns-v1"
+_PACKAGE = Path(__file__).resolve().parent.parent
+# the code a generator verdict depends on: the generator, and the terrain's rasters and support faces
+GENERATOR_SOURCES = (_PACKAGE / "contacts", _PACKAGE / "terrain")
+
+
+def generator_code_digest(roots=GENERATOR_SOURCES) -> str:
+    """sha256 (hex) of every .py file below `roots` (relative name and bytes), in order."""
+    digest = hashlib.sha256()
+    for root in roots:
+        root = Path(root)
+        for path in sorted(root.rglob("*.py")):
+            digest.update(f"{root.name}/{path.relative_to(root)}".encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def candidate_poses(field, config, seed: int = 0) -> np.ndarray:
+    """[S * spawn_yaws, 4] poses (x, y, z, yaw), world: `config.spawn_yaws` seeded random yaws
+    at each of the field's spawn points, z the terrain under the point + nominal root height
+    (the reset's own z rule, `LeasEnv.random_root`)."""
+    import jax.numpy as jnp
+
+    from leas_jax.env.field import sample_bilinear
+
+    xy = np.repeat(np.asarray(field.spawn_xy, dtype=np.float64), config.spawn_yaws, axis=0)
+    z = np.asarray(sample_bilinear(field, jnp.asarray(xy, dtype=jnp.float32)), dtype=np.float64)
+    yaw = np.random.default_rng(seed).uniform(-np.pi, np.pi, len(xy))
+    return np.column_stack([xy, z + config.nominal_root_height, yaw])
+
+
+def spawn_key(terrain_text: str, poses: np.ndarray, generator_config) -> str:
+    """sha256 (hex) of what the verdicts depend on: the poses, the terrain, the generator's
+    settings and code (`generator_code_digest`)."""
+    digest = hashlib.sha256(_FORMAT.encode())
+    digest.update(np.ascontiguousarray(poses, dtype=np.float64).tobytes())
+    digest.update(terrain_text.encode())
+    digest.update(repr(generator_config).encode())
+    digest.update(generator_code_digest().encode())
+    return digest.hexdigest()
+
+
+def _load_done(path: Path, key: str) -> np.ndarray:
+    """The verdicts cached in `path` under `key` (bool [k]; empty when missing or stale)."""
+    if not path.is_file():
+        return np.zeros(0, bool)
+    try:
+        with np.load(path) as data:
+            if str(data["key"]) != key:
+                return np.zeros(0, bool)
+            return np.asarray(data["stands"], bool)
+    except (OSError, ValueError, KeyError):  # a damaged cache file is rebuilt
+        return np.zeros(0, bool)
+
+
+def _save(path: Path, key: str, stands: np.ndarray) -> None:
+    from leas_jax.files import atomic_write_bytes
+
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, key=np.array(key), stands=stands)
+    atomic_write_bytes(path, buffer.getvalue())
+
+
+def standing_verdicts(
+    terrain, poses: np.ndarray, generator_config=None, workers: int | None = None, progress: bool = True
+) -> np.ndarray:
+    """bool [N]: whether the contact generator stands in double support at each pose [N, 4].
+
+    Host only. Cached (see the module docstring); `workers` as `ValidationPool`'s.
+    """
+    from leas_jax.contacts.planner.config import GeneratorConfig
+    from leas_jax.contacts.robot.database import cache_dir
+    from leas_jax.contacts.validation.pool import ValidationPool
+
+    config = GeneratorConfig() if generator_config is None else generator_config
+    key = spawn_key(terrain.text, poses, config)
+    path = cache_dir() / f"spawns_{key[:24]}.npz"
+    stands = _load_done(path, key)
+    if len(stands) >= len(poses):
+        return stands[: len(poses)]
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=len(poses), initial=len(stands), desc="spawn poses", unit="pose")
+    try:
+        with ValidationPool(terrain, workers=workers, config=config, return_plans=False) as pool:
+            while len(stands) < len(poses):
+                chunk = poses[len(stands) : len(stands) + CHUNK]
+                results = pool.map([pose[None] for pose in chunk], 1.0)
+                errors = [r.error for r in results if r.error is not None]
+                if errors:
+                    raise RuntimeError(f"the contact generator failed on a spawn pose: {errors[0]}")
+                stands = np.concatenate([stands, [r.last_valid_index == 0 for r in results]])
+                _save(path, key, stands)
+                if bar is not None:
+                    bar.update(len(chunk))
+    finally:
+        if bar is not None:
+            bar.close()
+    return stands
+
+
+def verified_spawns(field, terrain, config, generator_config=None, workers=None, progress=True, seed=0):
+    """The field with its spawns replaced by verified start poses (`spawn_xy`, `spawn_yaw`).
+
+    Args:
+        field: the terrain's `Heightfield` (its condition spawn points are the candidates).
+        terrain: the `Terrain` it was built from.
+        config: the `EnvConfig` (`spawn_yaws`, `nominal_root_height`).
+        generator_config: `GeneratorConfig` of the verdicts (None: defaults).
+        workers, progress: generator processes, progress bar.
+        seed: seed of the candidate yaws.
+
+    Returns:
+        Heightfield whose spawn table holds the candidates the generator stands on.
+
+    Raises:
+        UsageError: the generator stands on none of them.
+    """
+    import jax.numpy as jnp
+
+    from leas_jax.errors import UsageError
+
+    poses = candidate_poses(field, config, seed)
+    stands = standing_verdicts(terrain, poses, generator_config, workers, progress)
+    if not stands.any():
+        raise UsageError(
+            f"terrain {terrain.name!r}: the contact generator stands at none of the "
+            f"{len(poses)} spawn poses; use EnvConfig(spawns='condition')"
+        )
+    kept = poses[stands]
+    return dataclasses.replace(
+        field,
+        spawn_xy=jnp.asarray(kept[:, :2], dtype=jnp.float32),
+        spawn_yaw=jnp.asarray(kept[:, 3], dtype=jnp.float32),
+    )
+
+
+def arena_field(terrain, config, workers=None, progress=True):
+    """The `Heightfield` random resets start on: the terrain's, with verified spawns when
+    `config.spawns` is "generator" (host only; see `verified_spawns`)."""
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.errors import UsageError
+
+    if config.spawns not in SPAWN_MODES:
+        raise UsageError(f"EnvConfig.spawns must be one of {', '.join(SPAWN_MODES)}, got {config.spawns!r}")
+    if not (isinstance(config.spawn_yaws, int) and config.spawn_yaws >= 1):
+        raise UsageError(f"EnvConfig.spawn_yaws must be an integer >= 1, got {config.spawn_yaws!r}")
+    field = heightfield_from_terrain(terrain, config)
+    if config.spawns == "generator":
+        field = verified_spawns(field, terrain, config, workers=workers, progress=progress)
+    return field

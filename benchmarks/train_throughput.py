@@ -1,17 +1,19 @@
 """Geometric PPO throughput (env steps per second, learning included).
 
-For each preset (and optional overrides), compiles one training call, then
-times `--calls` calls. The bare reference env (`benchmarks/reference_env.py`) is
+For each preset and termination condition (`--conditions`: the presets' cylinders,
+the learned network of `EnvConfig(condition="learned")`), and optional overrides,
+compiles one training call, then times `--calls` calls. The bare reference env (`benchmarks/reference_env.py`) is
 timed at the preset's batch right before and after, and the training rate is also
 given as a ratio to the reference's (the mean of the two), which the machine's
 load moves less than env steps/s. Writes <out>/train_throughput.json.
 
-    python benchmarks/train_throughput.py [--presets quick,paper] [--calls 5]
+    python benchmarks/train_throughput.py [--presets quick,paper] [--conditions cylinders,learned] [--calls 5]
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import statistics
 import sys
@@ -46,6 +48,7 @@ def measure(config, field, calls: int) -> dict:
     steps = calls * config.iterations_per_call * config.batch_size
     return {
         "preset": config.preset,
+        "condition": config.env.condition,
         "num_envs": config.num_envs,
         "unroll_length": config.unroll_length,
         "num_minibatches": config.num_minibatches,
@@ -66,31 +69,39 @@ def measure(config, field, calls: int) -> dict:
 def main() -> None:
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import preset
+    from leas_jax.training.config import learned_condition_env, preset
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--presets", default="quick,paper")
     parser.add_argument("--calls", type=int, default=5)
     parser.add_argument("--epochs", default="", help="also measure these num_epochs values, e.g. 10,4")
+    parser.add_argument("--conditions", default="cylinders", help="comma-separated: cylinders, learned")
     add_out_argument(parser)
     args = parser.parse_args()
     load_before = load_average()
     rows = []
+    conditions = [c for c in args.conditions.split(",") if c]
+    if not conditions or set(conditions) - {"cylinders", "learned"}:
+        parser.error(
+            f"--conditions: expected a comma-separated subset of cylinders,learned, got {args.conditions!r}"
+        )
     for name in args.presets.split(","):
-        config = preset(name)
-        field = heightfield_from_terrain(load_terrain(config.terrain_path()), config.env)
-        variants = [config] + [preset(name, num_epochs=int(e)) for e in args.epochs.split(",") if e]
-        for variant in variants:
-            row = measure(variant, field, args.calls)
-            rows.append(row)
-            print(
-                f"{name:6s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
-                f"{row['env_steps_per_s']:>10,} env steps/s ({row['ratio_to_reference']:.3f} of the reference env's), "
-                f"80 M steps in {row['minutes_for_80M_steps']} min "
-                f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
-                f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)",
-                flush=True,
-            )
+        for condition in conditions:
+            configs = [preset(name)] + [preset(name, num_epochs=int(e)) for e in args.epochs.split(",") if e]
+            if condition == "learned":
+                configs = [dataclasses.replace(c, env=learned_condition_env(c.env)) for c in configs]
+            field = heightfield_from_terrain(load_terrain(configs[0].terrain_path()), configs[0].env)
+            for variant in configs:
+                row = measure(variant, field, args.calls)
+                rows.append(row)
+                print(
+                    f"{name:6s} {condition:9s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
+                    f"{row['env_steps_per_s']:>10,} env steps/s ({row['ratio_to_reference']:.3f} of the reference env's), "
+                    f"80 M steps in {row['minutes_for_80M_steps']} min "
+                    f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
+                    f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)",
+                    flush=True,
+                )
     save("train_throughput", {"rows": rows}, load_before, args.out)
 
 

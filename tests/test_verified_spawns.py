@@ -146,3 +146,38 @@ def test_bad_spawn_settings_name_the_field(pillar):
         spawns.arena_field(pillar, dataclasses.replace(CONFIG, spawns="anywhere"))
     with pytest.raises(UsageError, match="EnvConfig.spawn_yaws"):
         spawns.arena_field(pillar, dataclasses.replace(CONFIG, spawn_yaws=0))
+
+
+def test_train_command_selects_the_spawns():
+    from leas_jax.cli import build_parser
+    from leas_jax.training.commands import config_from_args
+
+    parser = build_parser()
+    chosen = config_from_args(
+        parser.parse_args(["train", "--out", "r", "--preset", "smoke", "--spawns", "generator"])
+    )
+    assert chosen.env.spawns == "generator"
+    assert (
+        config_from_args(parser.parse_args(["train", "--out", "r", "--preset", "smoke"])).env.spawns
+        == "condition"
+    )
+
+
+def test_training_starts_its_episodes_at_verified_poses(pillar, tmp_path, monkeypatch):
+    """`train` builds the verified spawns of its terrain (workers=0: in this process) and trains on them."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from training_helpers import tiny_config
+
+    from leas_jax.training.loop import train
+
+    monkeypatch.setenv("LEAS_CACHE_DIR", str(tmp_path / "cache"))
+    terrain_file = tmp_path / "pillar_pad.toml"
+    terrain_file.write_text(PILLAR)
+    config = tiny_config(terrain=str(terrain_file))
+    config = dataclasses.replace(config, env=dataclasses.replace(config.env, spawns="generator"))
+    result = train(config, tmp_path / "run", progress=False, workers=0)
+    assert result.env_steps == config.num_timesteps
+    assert list((tmp_path / "cache").glob("spawns_*.npz"))  # the verdicts were made and cached

@@ -28,13 +28,14 @@ def load_average() -> dict:
 
 
 def wilson(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
-    """95 % (z = 1.96) Wilson score interval of a proportion, as fractions; (nan, nan) without trials."""
+    """95 % (z = 1.96) Wilson score interval of a proportion, as fractions in [0, 1] (rounding
+    would put the bounds of 0 or n successes a hair past them); (nan, nan) without trials."""
     if trials == 0:
         return math.nan, math.nan
     p = successes / trials
     centre = (p + z * z / (2 * trials)) / (1 + z * z / trials)
     half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / (1 + z * z / trials)
-    return centre - half, centre + half
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def git_state(repo: Path = REPO) -> dict:

@@ -128,12 +128,8 @@ def evaluate_policy(run_dir: Path, args) -> dict:
     from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
 
-    policy = load_policy(run_dir)
+    policy = load_policy(run_dir)  # with a DAgger run's own refreshed condition
     env = policy.config.env
-    refreshed = run_dir / "condition.npz"
-    if env.condition == "learned" and refreshed.is_file():  # the DAgger run's own condition
-        env = dataclasses.replace(env, learned_weights=str(refreshed))
-    policy = dataclasses.replace(policy, config=dataclasses.replace(policy.config, env=env))
     arena = load_terrain(policy.config.terrain_path())
     field = heightfield_from_terrain(arena, env)
     full, coverage, progress = [], [], []

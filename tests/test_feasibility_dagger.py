@@ -91,6 +91,10 @@ def test_the_loop_adds_the_policys_failed_poses_and_refreshes_the_condition(tmp_
     refreshed, _ = lf.load_params(tmp_path / "run" / "condition.npz")
     assert not np.array_equal(np.asarray(refreshed["w0"]), np.asarray(params["w0"]))
     assert float(refreshed["threshold"]) > -1e9
+    # the trained policy carries the condition its last updates were made with
+    from leas_jax.training.policy import load_policy
+
+    assert load_policy(tmp_path / "run").config.env.learned_weights == str(tmp_path / "run" / "condition.npz")
 
 
 def test_a_run_saved_before_the_learned_condition_existed_still_resumes():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -50,7 +51,10 @@ def load_policy(path: str | Path | Policy, allow_pickle: bool = False) -> Policy
 
     The file's parameters are checked against the networks its config describes
     (same tree, shapes and dtypes) and must be finite, so a damaged or foreign file
-    fails here with one line rather than inside a rollout.
+    fails here with one line rather than inside a rollout. A policy trained with the
+    learned condition refreshed during planner-in-the-loop training (`condition.npz` beside
+    its `policy.ckpt`, `training.planner.VerdictData`) gets that condition as its
+    `env.learned_weights`: the one its last updates were made with.
 
     Args:
         path: run directory, policy file, or a loaded `Policy`.
@@ -82,6 +86,11 @@ def load_policy(path: str | Path | Policy, allow_pickle: bool = False) -> Policy
     normalizer, params = payload["normalizer"], payload["policy_params"]
     _check_like(file, "policy_params", params, _expected_params(config))
     _check_like(file, "normalizer", normalizer, _expected_normalizer(config))
+    refreshed = file.parent / "condition.npz"
+    if config.env.condition == "learned" and refreshed.is_file():
+        config = dataclasses.replace(
+            config, env=dataclasses.replace(config.env, learned_weights=str(refreshed))
+        )
     return Policy(config=config, normalizer=normalizer, params=params, env_steps=env_steps, source=str(file))
 
 

@@ -419,17 +419,31 @@ class Terrain:
         if not faces:
             return meshes
         owner = np.array([f[0] for f in faces])
-        probes = np.stack([_face_probes(corners) + _BURIED_PROBE * normal for _, corners, normal in faces])
-        covered = np.zeros(probes.shape[:2], dtype=bool)  # [F, P]
-        for index, box in enumerate(self.boxes):
-            covered |= box.contains(probes.reshape(-1, 3)).reshape(covered.shape) & (owner != index)[:, None]
-        buried = covered.all(axis=1)
+        buried = self._covered_by_others(
+            owner, np.array([f[1].mean(axis=0) + _BURIED_PROBE * f[2] for f in faces])
+        )
+        # a face free at its centre is not buried whole; the others are probed all over
+        maybe = np.flatnonzero(buried)
+        if len(maybe):
+            probes = np.stack(
+                [_face_probes(faces[i][1]) + _BURIED_PROBE * faces[i][2] for i in maybe]
+            )  # [M, P, 3]
+            grid = probes.shape[1]
+            covered = self._covered_by_others(np.repeat(owner[maybe], grid), probes.reshape(-1, 3))
+            buried[maybe] = covered.reshape(len(maybe), grid).all(axis=1)
         surfaces = [
             SupportSurface(corners, normal, index)
             for (index, corners, normal), hidden in zip(faces, buried)
             if not hidden
         ]
         return surfaces + meshes
+
+    def _covered_by_others(self, owner: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """[N] bool: each point [N, 3] lies inside a box other than its owner's (index [N])."""
+        covered = np.zeros(len(points), dtype=bool)
+        for index, box in enumerate(self.boxes):
+            covered |= box.contains(points) & (owner != index)
+        return covered
 
     def to_mjcf(self) -> str:
         """MuJoCo scene of the terrain: one `<geom type="box">` per box, one mesh geom per mesh.

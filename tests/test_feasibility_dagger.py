@@ -66,6 +66,7 @@ def test_the_loop_adds_the_policys_failed_poses_and_refreshes_the_condition(tmp_
         env=dataclasses.replace(env, episode_length=60),
         condition_refresh_every=1,
         condition_refresh_min_poses=10,
+        condition_anchor_poses=50,
     )
     records = []
     train(
@@ -80,6 +81,11 @@ def test_the_loop_adds_the_policys_failed_poses_and_refreshes_the_condition(tmp_
     assert "condition_threshold" in records[0]  # refreshed at the first iteration already
     with np.load(tmp_path / "run" / "condition_data.npz") as data:
         poses, labels = data["poses"], data["labels"]
+        anchors, anchor_labels = data["anchor_poses"], data["anchor_labels"]
+    # the anchors: drawn as resets are (flat eval_ground: z = nominal root height), labelled by
+    # the starting condition (threshold -1e9: every pose feasible)
+    assert anchors.shape == (50, 4) and anchor_labels.all()
+    np.testing.assert_allclose(anchors[:, 2], TRAINING_ENV.nominal_root_height, atol=1e-5)
     recorded = np.loadtxt(record_file, ndmin=2)
     failed = poses[~labels]
     # every failed pose of the validated batches is in the data, labelled infeasible (the
@@ -110,3 +116,26 @@ def test_a_run_saved_before_the_learned_condition_existed_still_resumes():
     assert _config_differences(saved, config) == []
     saved["seed"] = 5
     assert _config_differences(saved, config) == ["seed"]
+
+
+def test_anchor_samples_carry_the_conditions_own_verdicts():
+    """`anchor_samples` labels its poses with the field's condition (here the cylinders of a
+    field with a gap: poses over the gap are infeasible)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from training_helpers import gap_field
+
+    from leas_jax.env import condition
+    from leas_jax.env.config import EnvConfig
+    from leas_jax.training.planner import anchor_samples
+
+    field = gap_field()  # its spawn points: the default cylinders hold at every yaw
+    # legs 0.6 m to the side: beside the gap they reach over it at some yaws
+    env = EnvConfig(reachability=dataclasses.replace(EnvConfig().reachability, leg_lateral_offset=0.6))
+    poses, labels = anchor_samples(field, env, 400, np.random.default_rng(0))
+    assert poses.shape == (400, 4) and labels.shape == (400,)
+    expected = np.array([bool(condition.valid(field, jnp.asarray(p, jnp.float32), env)) for p in poses[:60]])
+    np.testing.assert_array_equal(labels[:60], expected)
+    assert 0.0 < labels.mean() < 1.0  # some beside the gap fail, most pass

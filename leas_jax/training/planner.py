@@ -310,6 +310,32 @@ def verdict_samples(
     return np.concatenate(poses).astype(np.float64), np.concatenate(labels)
 
 
+def anchor_samples(field: Heightfield, env_config, count: int, rng: np.random.Generator):
+    """Host: `count` poses drawn as resets draw them, labelled by the field's current condition.
+
+    Positions: spawn points jittered within the spawn spacing; yaw uniform; z the terrain
+    under the point + the nominal root height (`LeasEnv.random_root`, without its validity
+    filter). A refit that also fits these keeps the condition's verdicts where the policy's
+    guides do not go (see `VerdictData`).
+
+    Returns:
+        (poses [count, 4] float64 (x, y, z, yaw), world; labels [count] bool, the condition's).
+    """
+    from leas_jax.env import condition
+    from leas_jax.env.field import sample_bilinear
+
+    spawn = np.asarray(field.spawn_xy, dtype=np.float64)
+    xy = spawn[rng.integers(0, len(spawn), count)]
+    xy = xy + (rng.random((count, 2)) - 0.5) * float(field.spawn_spacing)
+    z = (
+        np.asarray(sample_bilinear(field, jnp.asarray(xy, jnp.float32)), np.float64)
+        + env_config.nominal_root_height
+    )
+    poses = np.column_stack([xy, z, rng.uniform(-np.pi, np.pi, count)])
+    valid = jax.jit(jax.vmap(lambda pose: condition.valid(field, pose, env_config)))
+    return poses, np.asarray(valid(jnp.asarray(poses, jnp.float32)), bool)
+
+
 class VerdictData:
     """Host: the DAgger loop of the learned condition during planner-in-the-loop training.
 
@@ -319,6 +345,9 @@ class VerdictData:
     (`leas_jax.feasibility.fit` with `init`) and the field carries the new weights: the next
     rollouts terminate where the refreshed condition says so, while the PPO update keeps the
     generator's pruning. Only with `config.env.condition == "learned"` and a refresh period > 0.
+    Every refit also fits `config.condition_anchor_poses` poses drawn as resets are and
+    labelled by the condition the run started with (`anchor_samples`), so that it keeps its
+    verdicts where the policy's guides do not go.
     """
 
     def __init__(self, config: TrainConfig, seed: int = 0):
@@ -328,6 +357,8 @@ class VerdictData:
         self.labels = np.zeros(0, bool)
         self.iterations = 0
         self.refreshes = 0
+        self.anchor_poses = np.zeros((0, 4))
+        self.anchor_labels = np.zeros(0, bool)
 
     @property
     def enabled(self) -> bool:
@@ -356,8 +387,14 @@ class VerdictData:
         from leas_jax.feasibility import FitConfig, features_of, fit
 
         reach = self.config.env.reachability
-        x = features_of(field.condition, field, self.poses, reach)
-        params, info = fit(x, self.labels, FitConfig(seed=self.refreshes), init=field.condition, reach=reach)
+        if self.refreshes == 0 and self.config.condition_anchor_poses > 0:
+            self.anchor_poses, self.anchor_labels = anchor_samples(
+                field, self.config.env, self.config.condition_anchor_poses, self.rng
+            )
+        poses = np.concatenate([self.anchor_poses, self.poses])
+        labels = np.concatenate([self.anchor_labels, self.labels])
+        x = features_of(field.condition, field, poses, reach)
+        params, info = fit(x, labels, FitConfig(seed=self.refreshes), init=field.condition, reach=reach)
         self.refreshes += 1
         return field.replace(condition=params), info
 
@@ -371,5 +408,11 @@ class VerdictData:
         run_dir = Path(run_dir)
         save_params(run_dir / "condition.npz", field.condition, refreshes=self.refreshes)
         tmp = run_dir / f"condition_data.tmp{os.getpid()}.npz"
-        np.savez(tmp, poses=self.poses, labels=self.labels)
+        np.savez(
+            tmp,
+            poses=self.poses,
+            labels=self.labels,
+            anchor_poses=self.anchor_poses,
+            anchor_labels=self.anchor_labels,
+        )
         os.replace(tmp, run_dir / "condition_data.npz")

@@ -39,3 +39,13 @@ PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylin
   --policy $LEARNED --out $D/condition_on_guides
 PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
   --policy $PLANNER --out $D/condition_on_guides_planner
+# the same planner phase with every refit anchored on 4000 reset-like poses labelled by the
+# starting condition (TrainConfig.condition_anchor_poses); kept in $D/train_paper_learned_anchored
+# PYTHONPATH=$PWD python $D/train_anchored.py runs/paper_learned runs/paper_learned_anchored
+ANCHORED=$D/train_paper_learned_anchored
+PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $ANCHORED --starts 256 --workers 2 \
+  --spawns condition --out $D/guides/learned_anchored/condition
+leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $ANCHORED \
+  --workers 2 --no-progress --out $D/evaluate_anchored
+PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+  --policy $ANCHORED --out $D/condition_on_guides_anchored

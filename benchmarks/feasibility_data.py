@@ -15,7 +15,8 @@ Labels are cached in .cache/feasibility_<set>_<key>.npz at the repository root, 
 the generator's settings (`GeneratorConfig`), the generator's sources
 (leas_jax/contacts/**/*.py and leas_jax/terrain/**/*.py) and the walking truth's guide. A change to any of them gives
 another key, so the labels are rebuilt. Labels are computed in chunks and the cache is
-rewritten (atomically) after each one: an interrupted build resumes where it stopped.
+rewritten (atomically) after each one (`leas_jax.feasibility.label_cache`): an interrupted
+build resumes where it stopped.
 Host-only.
 """
 
@@ -23,10 +24,8 @@ from __future__ import annotations
 
 import hashlib
 import multiprocessing
-import os
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +33,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import reachability_calibration as rc  # noqa: E402
+
+from leas_jax.feasibility.label_cache import cached_labels  # noqa: E402
 
 REPO = rc.REPO
 CACHE = REPO / ".cache"
@@ -66,63 +67,15 @@ def cache_file(name: str, key: str, cache: Path = CACHE) -> Path:
     return cache / f"feasibility_{name}_{key[:16]}.npz"
 
 
-def _atomic_savez(path: Path, **arrays) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
-    np.savez_compressed(tmp, **arrays)
-    os.replace(tmp, path)
+class _Progress:
+    """Prints labelling progress: poses done and the rate since the first computed chunk."""
 
+    def __init__(self, path: Path):
+        self.path, self.began = path, time.perf_counter()
 
-def load_partial(path: Path, poses: np.ndarray, key: str) -> np.ndarray:
-    """Labels cached in `path` for a prefix of `poses` [N, 4] under `key`: bool [k], k <= N
-    (empty when the file is missing, holds other poses or another key)."""
-    if not path.is_file():
-        return np.zeros(0, bool)
-    with np.load(path) as data:
-        if str(data["key"]) != key:
-            print(f"not reusing {path}: the generator or the terrain changed")
-            return np.zeros(0, bool)
-        done = int(data["done"])
-        if data["poses"].shape != poses.shape or not np.array_equal(data["poses"], poses):
-            print(f"not reusing {path}: other poses")
-            return np.zeros(0, bool)
-        return np.asarray(data["labels"][:done], bool)
-
-
-def cached_labels(
-    poses: np.ndarray,
-    key: str,
-    path: Path,
-    label_chunks: Callable[[list[np.ndarray]], object],
-    chunk: int = CHUNK,
-) -> np.ndarray:
-    """Labels of poses [N, 4], from the cache where it has them, the rest computed and cached.
-
-    Args:
-        poses: [N, 4] (x, y, z, yaw), world.
-        key: `dataset_key` of the labeller.
-        path: the cache file.
-        label_chunks: maps a list of pose chunks to an iterable of bool label arrays, in order
-            (a pool's imap, or a plain map in tests).
-        chunk: poses per chunk.
-
-    Returns:
-        bool [N]. The cache holds poses, labels, the number done and the key after every chunk.
-    """
-    poses = np.asarray(poses, np.float64)
-    labels = np.zeros(len(poses), bool)
-    done = len(known := load_partial(path, poses, key))
-    labels[:done] = known
-    if done < len(poses):
-        starts = range(done, len(poses), chunk)
-        began = time.perf_counter()
-        for start, part in zip(starts, label_chunks([poses[s : s + chunk] for s in starts]), strict=True):
-            labels[start : start + len(part)] = part
-            done = start + len(part)
-            _atomic_savez(path, poses=poses, labels=labels, done=done, key=key)
-            rate = (done - starts[0]) / (time.perf_counter() - began)
-            print(f"  {path.name}: {done} / {len(poses)} poses labelled ({rate:.2f} poses/s)", flush=True)
-    return labels
+    def __call__(self, done: int, total: int) -> None:
+        elapsed = time.perf_counter() - self.began
+        print(f"  {self.path.name}: {done} / {total} poses labelled ({elapsed:.0f} s)", flush=True)
 
 
 _WORKER = {}
@@ -158,10 +111,14 @@ def walking_labels(
     path = cache_file(name, key)
     if workers <= 1:
         _init_worker(terrain.text, generator_config)
-        return cached_labels(poses, key, path, lambda chunks: map(_walking_labels, chunks))
+        return cached_labels(
+            poses, key, path, lambda chunks: map(_walking_labels, chunks), CHUNK, _Progress(path)
+        )
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(workers, initializer=_init_worker, initargs=(terrain.text, generator_config)) as pool:
-        return cached_labels(poses, key, path, lambda chunks: pool.imap(_walking_labels, chunks))
+        return cached_labels(
+            poses, key, path, lambda chunks: pool.imap(_walking_labels, chunks), CHUNK, _Progress(path)
+        )
 
 
 def fresh_poses(terrain, count: int, seed: int) -> np.ndarray:

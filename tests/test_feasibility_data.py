@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from leas_jax.contacts.planner.generator import GeneratorConfig
+from leas_jax.feasibility.label_cache import cached_labels, load_partial
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 import feasibility_data as fd  # noqa: E402
@@ -48,26 +49,26 @@ def test_cache_reused_rebuilt_when_the_key_changes_and_resumed(tmp_path):
     path = tmp_path / "labels.npz"
     key = fd.dataset_key(TERRAIN, GeneratorConfig())
     first = Labeller()
-    labels = fd.cached_labels(poses, key, path, first, chunk=10)
+    labels = cached_labels(poses, key, path, first, chunk=10)
     np.testing.assert_array_equal(labels, poses[:, 0] > 0)
     assert first.poses == 25
     again = Labeller()
-    np.testing.assert_array_equal(fd.cached_labels(poses, key, path, again, chunk=10), labels)
+    np.testing.assert_array_equal(cached_labels(poses, key, path, again, chunk=10), labels)
     assert again.poses == 0  # from the cache
     other_key = fd.dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), max_candidates=8))
     rebuilt = Labeller()
-    fd.cached_labels(poses, other_key, path, rebuilt, chunk=10)
+    cached_labels(poses, other_key, path, rebuilt, chunk=10)
     assert rebuilt.poses == 25  # the generator config changed: every label recomputed
     other_poses = Labeller()
-    fd.cached_labels(poses + 1.0, other_key, path, other_poses, chunk=10)
+    cached_labels(poses + 1.0, other_key, path, other_poses, chunk=10)
     assert other_poses.poses == 25
     # an interrupted build keeps its finished chunks and resumes after them
     resumed_path = tmp_path / "resumed.npz"
     with pytest.raises(KeyboardInterrupt):
-        fd.cached_labels(poses, key, resumed_path, Labeller(fail_after=2), chunk=10)
-    assert len(fd.load_partial(resumed_path, poses, key)) == 20
+        cached_labels(poses, key, resumed_path, Labeller(fail_after=2), chunk=10)
+    assert len(load_partial(resumed_path, poses, key)) == 20
     rest = Labeller()
-    np.testing.assert_array_equal(fd.cached_labels(poses, key, resumed_path, rest, chunk=10), labels)
+    np.testing.assert_array_equal(cached_labels(poses, key, resumed_path, rest, chunk=10), labels)
     assert rest.poses == 5
 
 

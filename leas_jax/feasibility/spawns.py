@@ -10,18 +10,19 @@ the first pose of a one-pose guide through `ValidationPool`), and keeps the pose
 as the field's (spawn_xy, spawn_yaw) table; resets then start exactly at one of them.
 
 Host only (the generator is not jittable). Verdicts are cached in `cache_dir()` under a key
-of everything they depend on (terrain text, generator settings and code, the env's spawn
-settings), written chunk by chunk: an interrupted build resumes where it stopped.
+of everything they depend on (the poses, terrain text, generator settings and code), written
+chunk by chunk (`label_cache`): an interrupted build resumes where it stopped.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import hashlib
-import io
 from pathlib import Path
 
 import numpy as np
+
+from leas_jax.feasibility.label_cache import cached_labels
 
 SPAWN_MODES = ("condition", "generator")
 CHUNK = 2000  # poses per pool batch: a cache write and a progress-bar update each
@@ -67,33 +68,13 @@ def spawn_key(terrain_text: str, poses: np.ndarray, generator_config) -> str:
     return digest.hexdigest()
 
 
-def _load_done(path: Path, key: str) -> np.ndarray:
-    """The verdicts cached in `path` under `key` (bool [k]; empty when missing or stale)."""
-    if not path.is_file():
-        return np.zeros(0, bool)
-    try:
-        with np.load(path) as data:
-            if str(data["key"]) != key:
-                return np.zeros(0, bool)
-            return np.asarray(data["stands"], bool)
-    except (OSError, ValueError, KeyError):  # a damaged cache file is rebuilt
-        return np.zeros(0, bool)
-
-
-def _save(path: Path, key: str, stands: np.ndarray) -> None:
-    from leas_jax.files import atomic_write_bytes
-
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, key=np.array(key), stands=stands)
-    atomic_write_bytes(path, buffer.getvalue())
-
-
 def standing_verdicts(
     terrain, poses: np.ndarray, generator_config=None, workers: int | None = None, progress: bool = True
 ) -> np.ndarray:
     """bool [N]: whether the contact generator stands in double support at each pose [N, 4].
 
-    Host only. Cached (see the module docstring); `workers` as `ValidationPool`'s.
+    Host only. Cached in `cache_dir()` (`label_cache.cached_labels`, under `spawn_key`);
+    `workers` as `ValidationPool`'s.
     """
     from leas_jax.contacts.planner.config import GeneratorConfig
     from leas_jax.contacts.robot.database import cache_dir
@@ -101,31 +82,33 @@ def standing_verdicts(
 
     config = GeneratorConfig() if generator_config is None else generator_config
     key = spawn_key(terrain.text, poses, config)
-    path = cache_dir() / f"spawns_{key[:24]}.npz"
-    stands = _load_done(path, key)
-    if len(stands) >= len(poses):
-        return stands[: len(poses)]
+
+    def label_chunks(chunks):
+        with ValidationPool(terrain, workers=workers, config=config, return_plans=False) as pool:
+            for chunk in chunks:
+                results = pool.map([pose[None] for pose in chunk], 1.0)  # one-pose guides
+                errors = [r.error for r in results if r.error is not None]
+                if errors:
+                    raise RuntimeError(f"the contact generator failed on a spawn pose: {errors[0]}")
+                yield np.array([r.last_valid_index == 0 for r in results])
+
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=len(poses), initial=len(stands), desc="spawn poses", unit="pose")
+        bar = tqdm(total=len(poses), desc="spawn poses", unit="pose")
     try:
-        with ValidationPool(terrain, workers=workers, config=config, return_plans=False) as pool:
-            while len(stands) < len(poses):
-                chunk = poses[len(stands) : len(stands) + CHUNK]
-                results = pool.map([pose[None] for pose in chunk], 1.0)
-                errors = [r.error for r in results if r.error is not None]
-                if errors:
-                    raise RuntimeError(f"the contact generator failed on a spawn pose: {errors[0]}")
-                stands = np.concatenate([stands, [r.last_valid_index == 0 for r in results]])
-                _save(path, key, stands)
-                if bar is not None:
-                    bar.update(len(chunk))
+        return cached_labels(
+            poses,
+            key,
+            cache_dir() / f"spawns_{key[:24]}.npz",
+            label_chunks,
+            CHUNK,
+            None if bar is None else lambda done, _: bar.update(done - bar.n),
+        )
     finally:
         if bar is not None:
             bar.close()
-    return stands
 
 
 def verified_spawns(field, terrain, config, generator_config=None, workers=None, progress=True, seed=0):

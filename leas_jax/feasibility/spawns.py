@@ -43,18 +43,24 @@ def generator_code_digest(roots=GENERATOR_SOURCES) -> str:
     return digest.hexdigest()
 
 
-def candidate_poses(field, config, seed: int = 0) -> np.ndarray:
-    """[S * spawn_yaws, 4] poses (x, y, z, yaw), world: `config.spawn_yaws` seeded random yaws
-    at each of the field's spawn points, z the terrain under the point + nominal root height
-    (the reset's own z rule, `LeasEnv.random_root`)."""
+def root_poses(field, xy: np.ndarray, yaw: np.ndarray, nominal_root_height: float) -> np.ndarray:
+    """[N, 4] poses (x, y, z, yaw), world, of roots at world points xy [N, 2] with yaws [N]:
+    z the terrain under the point + the nominal root height (the reset's z rule,
+    `LeasEnv.random_root`)."""
     import jax.numpy as jnp
 
     from leas_jax.env.field import sample_bilinear
 
-    xy = np.repeat(np.asarray(field.spawn_xy, dtype=np.float64), config.spawn_yaws, axis=0)
     z = np.asarray(sample_bilinear(field, jnp.asarray(xy, dtype=jnp.float32)), dtype=np.float64)
+    return np.column_stack([np.asarray(xy, np.float64), z + nominal_root_height, yaw])
+
+
+def candidate_poses(field, config, seed: int = 0) -> np.ndarray:
+    """[S * spawn_yaws, 4] `root_poses`: `config.spawn_yaws` seeded random yaws at each of the
+    field's spawn points."""
+    xy = np.repeat(np.asarray(field.spawn_xy, dtype=np.float64), config.spawn_yaws, axis=0)
     yaw = np.random.default_rng(seed).uniform(-np.pi, np.pi, len(xy))
-    return np.column_stack([xy, z + config.nominal_root_height, yaw])
+    return root_poses(field, xy, yaw, config.nominal_root_height)
 
 
 def spawn_key(terrain_text: str, poses: np.ndarray, generator_config) -> str:

@@ -322,16 +322,12 @@ def anchor_samples(field: Heightfield, env_config, count: int, rng: np.random.Ge
         (poses [count, 4] float64 (x, y, z, yaw), world; labels [count] bool, the condition's).
     """
     from leas_jax.env import condition
-    from leas_jax.env.field import sample_bilinear
+    from leas_jax.feasibility.spawns import root_poses
 
     spawn = np.asarray(field.spawn_xy, dtype=np.float64)
     xy = spawn[rng.integers(0, len(spawn), count)]
     xy = xy + (rng.random((count, 2)) - 0.5) * float(field.spawn_spacing)
-    z = (
-        np.asarray(sample_bilinear(field, jnp.asarray(xy, jnp.float32)), np.float64)
-        + env_config.nominal_root_height
-    )
-    poses = np.column_stack([xy, z, rng.uniform(-np.pi, np.pi, count)])
+    poses = root_poses(field, xy, rng.uniform(-np.pi, np.pi, count), env_config.nominal_root_height)
     valid = jax.jit(jax.vmap(lambda pose: condition.valid(field, pose, env_config)))
     return poses, np.asarray(valid(jnp.asarray(poses, jnp.float32)), bool)
 

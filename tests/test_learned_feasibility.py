@@ -212,3 +212,28 @@ def test_train_command_selects_the_learned_condition():
     assert geometric.condition_refresh_every == 0 and planner.condition_refresh_every == LEARNED_REFRESH_EVERY
     default = config_from_args(parser.parse_args(["train", "--out", "r", "--preset", "smoke"]))
     assert default.env.condition == "cylinders"
+
+
+def test_train_command_takes_other_condition_weights(tmp_path):
+    """`--condition-weights FILE` selects the learned condition's weights; a missing file or the
+    option without `--reachability learned` is refused naming the option."""
+    from leas_jax.cli import build_parser
+    from leas_jax.errors import UsageError
+    from leas_jax.training.commands import config_from_args
+
+    weights = tmp_path / "other.npz"
+    weights.write_bytes(b"")
+    parser = build_parser()
+    base = ["train", "--out", "r", "--preset", "smoke"]
+    chosen = config_from_args(
+        parser.parse_args([*base, "--reachability", "learned", "--condition-weights", str(weights)])
+    )
+    assert chosen.env.condition == "learned" and chosen.env.learned_weights == str(weights)
+    with pytest.raises(UsageError, match="--condition-weights: no such file"):
+        config_from_args(
+            parser.parse_args(
+                [*base, "--reachability", "learned", "--condition-weights", str(tmp_path / "missing.npz")]
+            )
+        )
+    with pytest.raises(UsageError, match="--condition-weights is for --reachability learned"):
+        config_from_args(parser.parse_args([*base, "--condition-weights", str(weights)]))

@@ -78,6 +78,14 @@ def add_training_arguments(parser) -> None:
         "guides: docs/results/2026-12-01-feasibility)",
     )
     parser.add_argument(
+        "--condition-weights",
+        metavar="FILE",
+        default=None,
+        help="with --reachability learned: the learned condition's weights (default "
+        "checkpoints/feasibility/walking.npz; checkpoints/feasibility/walking_paths.npz is refitted "
+        "on the generator's whole-path verdicts, benchmarks/condition_from_paths.py)",
+    )
+    parser.add_argument(
         "--spawns",
         choices=["condition", "generator"],
         default="condition",
@@ -130,12 +138,21 @@ def config_from_args(args):
         config = dataclasses.replace(
             config, env=dataclasses.replace(config.env, reachability=ReachabilityConfig())
         )
+    weights = args.condition_weights
+    if weights is not None and args.reachability != "learned":
+        raise UsageError("--condition-weights is for --reachability learned")
     if args.reachability == "learned":
+        from leas_jax.env.config import EnvConfig
+        from leas_jax.env.learned_weights import resolve_weights
         from leas_jax.training.config import LEARNED_REFRESH_EVERY, learned_condition_env
 
+        if weights is None:
+            weights = EnvConfig.learned_weights
+        elif not resolve_weights(weights).is_file():
+            raise UsageError(f"--condition-weights: no such file: {weights}")
         refresh = LEARNED_REFRESH_EVERY if config.mode == "planner" else 0
         config = dataclasses.replace(
-            config, env=learned_condition_env(config.env), condition_refresh_every=refresh
+            config, env=learned_condition_env(config.env, weights), condition_refresh_every=refresh
         )
     if args.spawns != config.env.spawns:
         config = dataclasses.replace(config, env=dataclasses.replace(config.env, spawns=args.spawns))

@@ -10,16 +10,21 @@ covers end to end, and a policy trained with it stops before beams and stairs
 This script labels poses with what the generator does on whole paths instead. A teacher
 policy that crosses beams and climbs stairs (default: the geometric pretrain with the
 paper's cylinders) draws `--episodes` guides on its training arena from the env's random
-resets; the generator plans each, and `leas_jax.training.planner.verdict_samples` turns
+resets; the generator plans each (kept in --out/teacher_guides_<k>.npz and read back by a
+rerun with the same settings), and `leas_jax.training.planner.verdict_samples` turns
 the verdicts into labelled poses (covered poses the generator followed for 20 more
 poses: feasible; the first pose it could not pass: infeasible). The condition is refitted
 from the shipped weights on those poses together with `--anchors` poses drawn as resets
 are and labelled by the shipped condition (`anchor_samples`), so that it keeps its
 verdicts where the teacher's guides do not go. Its threshold is set for
-`FitConfig.target_sensitivity` on the poses kept aside.
+`FitConfig.target_sensitivity` on the poses kept aside, or (`--path-sensitivity`) so that
+a share of the fitted guides' surely feasible prefixes pass whole: per-pose errors
+compound along a 400-pose guide. Several teachers aggregate their verdicts: a DAgger round
+refits on the guides of the policy trained with the last refit together with the earlier
+teachers'.
 
-Both conditions are then checked on `--holdout` other guides of the teacher (another
-reset seed), per path (does the condition end a guide the generator covers? does it stop
+Both conditions (before and after the refit) are then checked on `--holdout` other guides
+of each teacher (another reset seed), per path (does the condition end a guide the generator covers? does it stop
 a guide at or before the pose the generator could not pass?) and per pose, with 95 %
 Wilson intervals; covered guides' false ends are broken down by arena cell. Writes the
 weights to --weights-out and condition_from_paths.json / .md into --out.
@@ -132,15 +137,24 @@ def prefix_minima(logits, last_valid, horizon: int) -> np.ndarray:
 
 
 def plan_teacher_guides(
-    teacher, arena, field, episodes: int, holdout: int, seed: int, workers: int, cache: Path
+    teacher_path: str,
+    teacher,
+    arena,
+    field,
+    episodes: int,
+    holdout: int,
+    seed: int,
+    workers: int,
+    cache: Path,
 ):
-    """(fitted guides, their last valid indices, holdout guides, theirs): `episodes` teacher
+    """(fitted guides, their last valid indices, holdout guides, theirs): `episodes` guides of the
+    policy `teacher` (loaded from `teacher_path`)
     guides from reset seed `seed` and `holdout` from `seed + 1`, planned by the generator;
     kept in `cache` (.npz) and read back from it when it matches these settings."""
     from leas_jax.contacts.validation.pool import validate_paths
     from leas_jax.eval.geometric import arena_episodes
 
-    settings = np.asarray(f"{teacher.config.terrain} {episodes} {holdout} {seed}")
+    settings = np.asarray(f"{teacher_path} {teacher.config.terrain} {episodes} {holdout} {seed}")
     if cache.is_file():
         with np.load(cache) as data:
             if str(data["settings"]) == str(settings):
@@ -178,7 +192,11 @@ def main(argv=None) -> dict:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--teacher", default="checkpoints/leas_talos/pretrain", help="run directory or policy.ckpt"
+        "--teacher",
+        nargs="+",
+        default=["checkpoints/leas_talos/pretrain"],
+        help="run directories or policy.ckpt files whose guides' verdicts are fitted (aggregated: a "
+        "DAgger round adds the policy trained with the last refit)",
     )
     parser.add_argument(
         "--weights", default="checkpoints/feasibility/walking.npz", help="weights refitted from"
@@ -221,23 +239,31 @@ def main(argv=None) -> dict:
     from leas_jax.training.planner import VERDICT_HORIZON, anchor_samples, verdict_samples
     from leas_jax.training.policy import load_policy
 
-    teacher = load_policy(args.teacher)
-    arena = load_terrain(teacher.config.terrain_path())
-    learned_env = learned_condition_env(teacher.config.env, args.weights)
+    teachers = [load_policy(path) for path in args.teacher]
+    arena = load_terrain(teachers[0].config.terrain_path())
+    if any(t.config.terrain_path() != teachers[0].config.terrain_path() for t in teachers):
+        parser.error("--teacher: the policies were trained on different terrains")
+    learned_env = learned_condition_env(teachers[0].config.env, args.weights)
     field = heightfield_from_terrain(arena, learned_env)
     reach = learned_env.reachability
     base, base_meta = load_params(resolve_weights(args.weights))
     out = Path(args.out)
-    fitted_guides, fitted_lvi, holdout_guides, holdout_lvi = plan_teacher_guides(
-        teacher,
-        arena,
-        arena_field(arena, teacher.config.env, workers=args.workers),
-        args.episodes,
-        args.holdout,
-        args.seed,
-        args.workers,
-        out / "teacher_guides.npz",
-    )
+    planned = {
+        path: plan_teacher_guides(
+            path,
+            teacher,
+            arena,
+            arena_field(arena, teacher.config.env, workers=args.workers),
+            args.episodes,
+            args.holdout,
+            args.seed,
+            args.workers,
+            out / f"teacher_guides_{k}.npz",
+        )
+        for k, (path, teacher) in enumerate(zip(args.teacher, teachers, strict=True))
+    }
+    fitted_guides = [g for p in planned.values() for g in p[0]]
+    fitted_lvi = np.concatenate([p[1] for p in planned.values()])
 
     rng = np.random.default_rng(args.seed)
     path_poses, path_labels = verdict_samples(fitted_guides, fitted_lvi, rng, args.covered_per_guide)
@@ -255,8 +281,8 @@ def main(argv=None) -> dict:
         Path(args.weights_out),
         params,
         refitted_from=args.weights,
-        teacher=args.teacher,
-        train=f"{len(path_poses)} path-verdict poses of {args.episodes} teacher guides (seed {args.seed}) "
+        teacher=" ".join(args.teacher),
+        train=f"{len(path_poses)} path-verdict poses of {args.episodes} guides (seed {args.seed}) of each teacher "
         f"+ {args.anchors} anchors labelled by {args.weights}",
         fit=json.dumps(
             {
@@ -269,40 +295,44 @@ def main(argv=None) -> dict:
     )
 
     cells = cell_kinds(arena.text)
-    holdout_poses, holdout_labels = verdict_samples(
-        holdout_guides, holdout_lvi, np.random.default_rng(args.seed + 1), args.covered_per_guide
-    )
+    fitted_minima = {
+        name: prefix_minima(guide_logits(weights, field, reach, fitted_guides), fitted_lvi, VERDICT_HORIZON)
+        for name, weights in (("before", base), ("after", params))
+    }
     conditions = {}
-    for name, weights in (("shipped", base), ("refitted", params)):
-        logits = guide_logits(weights, field, reach, holdout_guides)
-        rejected = [lg < float(weights["threshold"]) for lg in logits]
-        outcome = path_outcomes(rejected, holdout_lvi, VERDICT_HORIZON)
-        ended_cells = Counter(
-            kind_at(cells, g[np.argmax(r), :2])
-            for g, r, lvi in zip(holdout_guides, rejected, holdout_lvi, strict=True)
-            if lvi >= len(g) - 1 and r.any()
-        )
-        fitted_minima = prefix_minima(
-            guide_logits(weights, field, reach, fitted_guides), fitted_lvi, VERDICT_HORIZON
-        )
-        trade = []
-        for target in (0.5, 0.7, 0.8, 0.9, 0.95):
-            threshold = threshold_for(fitted_minima, np.ones(len(fitted_minima), bool), target)
-            at = path_outcomes([lg < threshold for lg in logits], holdout_lvi, VERDICT_HORIZON)
-            trade.append({"path_sensitivity": target, "threshold": threshold, **at})
-        conditions[name] = {
-            **outcome,
-            "threshold": float(weights["threshold"]),
-            "covered_ended_95ci": list(wilson(outcome["covered_ended"], outcome["covered"])),
-            "failed_stopped_95ci": list(wilson(outcome["failed_stopped"], outcome["failed"])),
-            "covered_ended_by_cell": dict(ended_cells.most_common()),
-            "holdout_poses": rates(
-                predict(weights, features_of(weights, field, holdout_poses, reach)), holdout_labels
-            ),
-            "path_thresholds": trade,
-        }
+    for name, weights in (("before", base), ("after", params)):
+        conditions[name] = {}
+        for path, (_, _, holdout_guides, holdout_lvi) in planned.items():
+            logits = guide_logits(weights, field, reach, holdout_guides)
+            rejected = [lg < float(weights["threshold"]) for lg in logits]
+            outcome = path_outcomes(rejected, holdout_lvi, VERDICT_HORIZON)
+            ended_cells = Counter(
+                kind_at(cells, g[np.argmax(r), :2])
+                for g, r, lvi in zip(holdout_guides, rejected, holdout_lvi, strict=True)
+                if lvi >= len(g) - 1 and r.any()
+            )
+            trade = []
+            for target in (0.5, 0.7, 0.8, 0.9, 0.95):
+                minima = fitted_minima[name]
+                threshold = threshold_for(minima, np.ones(len(minima), bool), target)
+                at = path_outcomes([lg < threshold for lg in logits], holdout_lvi, VERDICT_HORIZON)
+                trade.append({"path_sensitivity": target, "threshold": threshold, **at})
+            holdout_poses, holdout_labels = verdict_samples(
+                holdout_guides, holdout_lvi, np.random.default_rng(args.seed + 1), args.covered_per_guide
+            )
+            conditions[name][path] = {
+                **outcome,
+                "threshold": float(weights["threshold"]),
+                "covered_ended_95ci": list(wilson(outcome["covered_ended"], outcome["covered"])),
+                "failed_stopped_95ci": list(wilson(outcome["failed_stopped"], outcome["failed"])),
+                "covered_ended_by_cell": dict(ended_cells.most_common()),
+                "holdout_poses": rates(
+                    predict(weights, features_of(weights, field, holdout_poses, reach)), holdout_labels
+                ),
+                "path_thresholds": trade,
+            }
     report = {
-        "teacher": args.teacher,
+        "teachers": args.teacher,
         "weights": args.weights,
         "weights_out": args.weights_out,
         "terrain": arena.name,
@@ -313,6 +343,7 @@ def main(argv=None) -> dict:
         "path_feasible": int(path_labels.sum()),
         "anchors": int(len(anchor_poses)),
         "anchors_feasible": int(anchor_labels.sum()),
+        "fitted_guides": len(fitted_guides),
         "fitted_guides_covered": int(np.sum(fitted_lvi >= np.array([len(g) - 1 for g in fitted_guides]))),
         "fit": info,
         "conditions": conditions,
@@ -327,39 +358,45 @@ def main(argv=None) -> dict:
 def markdown(report: dict) -> str:
     """The report's tables."""
     lines = [
-        f"Condition refitted from {report['weights']} on the generator's verdicts on {report['episodes']} "
-        f"guides of {report['teacher']} ({report['fitted_guides_covered']} fully covered; "
-        f"{report['path_poses']} poses, {report['path_feasible']} feasible) + {report['anchors']} anchors "
+        f"Condition refitted from {report['weights']} on the generator's verdicts on "
+        f"{report['fitted_guides']} guides of {', '.join(report['teachers'])} "
+        f"({report['fitted_guides_covered']} fully covered; {report['path_poses']} poses, "
+        f"{report['path_feasible']} feasible) + {report['anchors']} anchors "
         f"({report['anchors_feasible']} feasible); threshold {report['fit']['threshold']:.3f}.",
         "",
-        f"Checked on {report['holdout']} other guides of the teacher:",
+        f"Checked on {report['holdout']} other guides of each teacher (before: {report['weights']}, "
+        f"after: {report['weights_out']}):",
         "",
-        "| condition | covered guides it ends [95 % CI] | failed guides it stops [95 % CI] | "
+        "| condition | teacher | covered guides it ends [95 % CI] | failed guides it stops [95 % CI] | "
         "sensitivity (poses) | specificity (poses) | covered guides ended, by cell |",
-        "|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|",
     ]
-    for name, c in report["conditions"].items():
-        e, s, p = c["covered_ended_95ci"], c["failed_stopped_95ci"], c["holdout_poses"]
-        by_cell = ", ".join(f"{k} {v}" for k, v in c["covered_ended_by_cell"].items()) or "none"
-        lines.append(
-            f"| {name} | {c['covered_ended']} / {c['covered']} [{100 * e[0]:.1f}, {100 * e[1]:.1f} %] | "
-            f"{c['failed_stopped']} / {c['failed']} [{100 * s[0]:.1f}, {100 * s[1]:.1f} %] | "
-            f"{100 * p['sensitivity']:.1f} % | {100 * p['specificity']:.1f} % | {by_cell} |"
-        )
+    for name, by_teacher in report["conditions"].items():
+        for teacher, c in by_teacher.items():
+            e, s, p = c["covered_ended_95ci"], c["failed_stopped_95ci"], c["holdout_poses"]
+            by_cell = ", ".join(f"{k} {v}" for k, v in c["covered_ended_by_cell"].items()) or "none"
+            lines.append(
+                f"| {name} | {teacher} | {c['covered_ended']} / {c['covered']} "
+                f"[{100 * e[0]:.1f}, {100 * e[1]:.1f} %] | {c['failed_stopped']} / {c['failed']} "
+                f"[{100 * s[0]:.1f}, {100 * s[1]:.1f} %] | {100 * p['sensitivity']:.1f} % | "
+                f"{100 * p['specificity']:.1f} % | {by_cell} |"
+            )
     lines += [
         "",
         "Thresholds set for a share of the fitted guides' surely feasible prefixes passing whole, "
         "checked on the held-out guides:",
         "",
-        "| condition | prefixes passing (fitted) | threshold | covered guides it ends | failed guides it stops |",
-        "|---|---|---|---|---|",
+        "| condition | teacher | prefixes passing (fitted) | threshold | covered guides it ends | "
+        "failed guides it stops |",
+        "|---|---|---|---|---|---|",
     ]
-    for name, c in report["conditions"].items():
-        for t in c["path_thresholds"]:
-            lines.append(
-                f"| {name} | {100 * t['path_sensitivity']:.0f} % | {t['threshold']:.3f} | "
-                f"{t['covered_ended']} / {t['covered']} | {t['failed_stopped']} / {t['failed']} |"
-            )
+    for name, by_teacher in report["conditions"].items():
+        for teacher, c in by_teacher.items():
+            for t in c["path_thresholds"]:
+                lines.append(
+                    f"| {name} | {teacher} | {100 * t['path_sensitivity']:.0f} % | {t['threshold']:.3f} | "
+                    f"{t['covered_ended']} / {t['covered']} | {t['failed_stopped']} / {t['failed']} |"
+                )
     return "\n".join(lines) + "\n"
 
 

@@ -16,7 +16,8 @@ the verdicts into labelled poses (covered poses the generator followed for 20 mo
 poses: feasible; the first pose it could not pass: infeasible). The condition is refitted
 from the shipped weights on those poses together with `--anchors` poses drawn as resets
 are and labelled by the shipped condition (`anchor_samples`), so that it keeps its
-verdicts where the teacher's guides do not go. Its threshold is set for
+verdicts where the teacher's guides do not go (the labelled path poses are also written to
+--out/path_verdicts.npz, for `leas train --condition-seed-data`). Its threshold is set for
 `FitConfig.target_sensitivity` on the poses kept aside, or (`--path-sensitivity`) so that
 a share of the fitted guides' surely feasible prefixes pass whole: per-pose errors
 compound along a 400-pose guide. Several teachers aggregate their verdicts: a DAgger round
@@ -30,7 +31,7 @@ Wilson intervals; covered guides' false ends are broken down by arena cell. Writ
 weights to --weights-out and condition_from_paths.json / .md into --out.
 
     python benchmarks/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
-        --weights-out checkpoints/feasibility/walking_paths.npz --out DIR
+        --weights-out DIR/condition.npz --out DIR
 """
 
 from __future__ import annotations
@@ -267,6 +268,10 @@ def main(argv=None) -> dict:
 
     rng = np.random.default_rng(args.seed)
     path_poses, path_labels = verdict_samples(fitted_guides, fitted_lvi, rng, args.covered_per_guide)
+    out.mkdir(parents=True, exist_ok=True)
+    tmp = out / "path_verdicts.tmp.npz"
+    np.savez(tmp, poses=path_poses, labels=path_labels)  # TrainConfig.condition_seed_data's format
+    tmp.replace(out / "path_verdicts.npz")
     anchor_poses, anchor_labels = anchor_samples(field, learned_env, args.anchors, rng)
     poses = np.concatenate([path_poses, anchor_poses])
     labels = np.concatenate([path_labels, anchor_labels])

@@ -139,3 +139,86 @@ def test_anchor_samples_carry_the_conditions_own_verdicts():
     expected = np.array([bool(condition.valid(field, jnp.asarray(p, jnp.float32), env)) for p in poses[:60]])
     np.testing.assert_array_equal(labels[:60], expected)
     assert 0.0 < labels.mean() < 1.0  # some beside the gap fail, most pass
+
+
+def test_seed_data_is_fitted_at_every_refresh(tmp_path, monkeypatch):
+    """`TrainConfig.condition_seed_data`: its labelled poses join the verdicts in every refit."""
+    import leas_jax.feasibility as feasibility
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.planner import VerdictData
+
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=reach)
+    weights = lf.save_params(tmp_path / "start.npz", {**params, "threshold": jnp.asarray(0.0)})
+    env = dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(weights))
+    seed_poses = np.column_stack(
+        [np.linspace(3.0, 5.0, 30), np.full(30, 4.0), np.full(30, 1.0), np.zeros(30)]
+    )
+    seed_labels = np.arange(30) % 3 == 0
+    np.savez(tmp_path / "seed.npz", poses=seed_poses, labels=seed_labels)
+    config = dataclasses.replace(
+        preset("smoke", mode="planner"),
+        env=env,
+        condition_refresh_every=1,
+        condition_seed_data=str(tmp_path / "seed.npz"),
+    )
+    field = heightfield_from_terrain(load_terrain("terrains/eval_ground.toml"), env)
+    verdicts = VerdictData(config)
+    verdicts.add([_guide(50, 3.0), _guide(40, 4.0)], np.array([29, 39]))
+    fitted = {}
+
+    def spy(x, y, *args, **kwargs):
+        fitted["x"], fitted["y"] = x, y
+        return fit(x, y, *args, **kwargs)
+
+    fit = feasibility.fit
+    monkeypatch.setattr(feasibility, "fit", spy)
+    verdicts.refresh(field)
+    own = len(verdicts.labels)
+    assert len(fitted["y"]) == 30 + own
+    np.testing.assert_array_equal(fitted["y"][:30], seed_labels)
+    expected = feasibility.features_of(field.condition, field, seed_poses, reach)
+    np.testing.assert_allclose(fitted["x"][:30], expected, rtol=1e-5, atol=1e-5)
+
+
+def test_bad_seed_data_is_refused_naming_the_field(tmp_path):
+    import pytest
+
+    from leas_jax.errors import UsageError
+    from leas_jax.training.planner import seed_data
+
+    cases = {
+        "missing.npz": None,
+        "no_labels.npz": {"poses": np.zeros((3, 4))},
+        "short_poses.npz": {"poses": np.zeros((3, 3)), "labels": np.ones(3, bool)},
+        "float_labels.npz": {"poses": np.zeros((3, 4)), "labels": np.ones(3)},
+        "nan.npz": {"poses": np.full((3, 4), np.nan), "labels": np.ones(3, bool)},
+    }
+    for name, arrays in cases.items():
+        if arrays is not None:
+            np.savez(tmp_path / name, **arrays)
+        with pytest.raises(UsageError, match=f"TrainConfig.condition_seed_data: .*{name}"):
+            seed_data(tmp_path / name)
+    np.savez(tmp_path / "good.npz", poses=np.zeros((3, 4)), labels=np.array([True, False, True]))
+    poses, labels = seed_data(tmp_path / "good.npz")
+    assert poses.shape == (3, 4) and labels.tolist() == [True, False, True]
+
+
+def test_train_command_takes_seed_data_for_the_dagger_phase_only(tmp_path):
+    import pytest
+
+    from leas_jax.cli import build_parser
+    from leas_jax.errors import UsageError
+    from leas_jax.training.commands import config_from_args
+
+    np.savez(tmp_path / "seed.npz", poses=np.zeros((3, 4)), labels=np.array([True, False, True]))
+    parser = build_parser()
+    base = ["train", "--out", "r", "--preset", "smoke", "--condition-seed-data", str(tmp_path / "seed.npz")]
+    chosen = config_from_args(parser.parse_args([*base, "--mode", "planner", "--reachability", "learned"]))
+    assert chosen.condition_seed_data == str(tmp_path / "seed.npz")
+    for extra in ([], ["--reachability", "learned"], ["--mode", "planner"]):
+        with pytest.raises(
+            UsageError, match="--condition-seed-data is for --mode planner --reachability learned"
+        ):
+            config_from_args(parser.parse_args([*base, *extra]))

@@ -82,8 +82,16 @@ def add_training_arguments(parser) -> None:
         metavar="FILE",
         default=None,
         help="with --reachability learned: the learned condition's weights (default "
-        "checkpoints/feasibility/walking.npz; checkpoints/feasibility/walking_paths.npz is refitted "
-        "on the generator's whole-path verdicts, benchmarks/condition_from_paths.py)",
+        "checkpoints/feasibility/walking.npz; benchmarks/condition_from_paths.py refits them on the "
+        "generator's whole-path verdicts)",
+    )
+    parser.add_argument(
+        "--condition-seed-data",
+        metavar="FILE",
+        default=None,
+        help="with --mode planner --reachability learned: labelled poses (.npz of poses [K, 4] and "
+        "labels [K]) that every refresh of the condition also fits, e.g. the path_verdicts.npz of "
+        "benchmarks/condition_from_paths.py or an earlier run's condition_data.npz",
     )
     parser.add_argument(
         "--spawns",
@@ -154,6 +162,15 @@ def config_from_args(args):
         config = dataclasses.replace(
             config, env=learned_condition_env(config.env, weights), condition_refresh_every=refresh
         )
+    if args.condition_seed_data is not None:
+        if args.reachability != "learned" or config.mode != "planner":
+            raise UsageError("--condition-seed-data is for --mode planner --reachability learned")
+        from leas_jax.training.planner import seed_data
+
+        seed_data(
+            args.condition_seed_data
+        )  # refused here, naming the file, rather than after the first batch
+        config = dataclasses.replace(config, condition_seed_data=args.condition_seed_data)
     if args.spawns != config.env.spawns:
         config = dataclasses.replace(config, env=dataclasses.replace(config.env, spawns=args.spawns))
     return config

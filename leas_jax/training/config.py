@@ -125,6 +125,11 @@ class TrainConfig:
     # anchors kept that to 1.8 %, still enough to end 55 of 60 climbs, and the policy still
     # stopped (docs/results/2026-12-01-learned-paper): so off by default.
     condition_anchor_poses: int = 0
+    # An .npz of labelled poses (`poses` [K, 4] (x, y, z, yaw), world; `labels` [K] bool) that
+    # every refit also fits, the DAgger loop's aggregated data carried from elsewhere: the
+    # generator's verdicts on another policy's whole guides (benchmarks/condition_from_paths.py's
+    # path_verdicts.npz) or an earlier run's condition_data.npz. "": none.
+    condition_seed_data: str = ""
     checkpoint_every_s: float = 60.0  # wall-clock seconds between checkpoints
     keep_checkpoints: int = 3
     env: EnvConfig = field(

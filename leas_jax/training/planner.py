@@ -332,6 +332,27 @@ def anchor_samples(field: Heightfield, env_config, count: int, rng: np.random.Ge
     return poses, np.asarray(valid(jnp.asarray(poses, jnp.float32)), bool)
 
 
+def seed_data(path) -> tuple[np.ndarray, np.ndarray]:
+    """Host: the labelled poses of `TrainConfig.condition_seed_data`: (poses [K, 4] float64,
+    labels [K] bool). Raises UsageError naming the file and the field when it cannot be used."""
+    from leas_jax.errors import UsageError
+    from leas_jax.training.config import resolve_data_path
+
+    where = f"TrainConfig.condition_seed_data: {path}"
+    try:
+        with np.load(resolve_data_path(path), allow_pickle=False) as data:
+            poses, labels = np.asarray(data["poses"], np.float64), np.asarray(data["labels"])
+    except (OSError, ValueError, KeyError) as error:
+        raise UsageError(f"{where}: not an .npz with 'poses' and 'labels' ({error})") from None
+    if poses.ndim != 2 or poses.shape[1] != 4 or labels.shape != (len(poses),) or labels.dtype != bool:
+        raise UsageError(
+            f"{where}: needs poses [K, 4] and bool labels [K], got {poses.shape} and {labels.shape} {labels.dtype}"
+        )
+    if not np.isfinite(poses).all():
+        raise UsageError(f"{where}: poses hold nan or inf")
+    return poses, labels
+
+
 class VerdictData:
     """Host: the DAgger loop of the learned condition during planner-in-the-loop training.
 
@@ -343,7 +364,8 @@ class VerdictData:
     generator's pruning. Only with `config.env.condition == "learned"` and a refresh period > 0.
     Every refit also fits `config.condition_anchor_poses` poses drawn as resets are and
     labelled by the condition the run started with (`anchor_samples`), so that it keeps its
-    verdicts where the policy's guides do not go.
+    verdicts where the policy's guides do not go, and the labelled poses of
+    `config.condition_seed_data` (`seed_data`).
     """
 
     def __init__(self, config: TrainConfig, seed: int = 0):
@@ -355,6 +377,11 @@ class VerdictData:
         self.refreshes = 0
         self.anchor_poses = np.zeros((0, 4))
         self.anchor_labels = np.zeros(0, bool)
+        self.seed_poses, self.seed_labels = (
+            seed_data(config.condition_seed_data)
+            if config.condition_seed_data
+            else (np.zeros((0, 4)), np.zeros(0, bool))
+        )
 
     @property
     def enabled(self) -> bool:
@@ -387,8 +414,8 @@ class VerdictData:
             self.anchor_poses, self.anchor_labels = anchor_samples(
                 field, self.config.env, self.config.condition_anchor_poses, self.rng
             )
-        poses = np.concatenate([self.anchor_poses, self.poses])
-        labels = np.concatenate([self.anchor_labels, self.labels])
+        poses = np.concatenate([self.anchor_poses, self.seed_poses, self.poses])
+        labels = np.concatenate([self.anchor_labels, self.seed_labels, self.labels])
         x = features_of(field.condition, field, poses, reach)
         params, info = fit(x, labels, FitConfig(seed=self.refreshes), init=field.condition, reach=reach)
         self.refreshes += 1

@@ -128,7 +128,10 @@ class TrainConfig:
     # An .npz of labelled poses (`poses` [K, 4] (x, y, z, yaw), world; `labels` [K] bool) that
     # every refit also fits, the DAgger loop's aggregated data carried from elsewhere: the
     # generator's verdicts on another policy's whole guides (benchmarks/condition_from_paths.py's
-    # path_verdicts.npz) or an earlier run's condition_data.npz. "": none.
+    # path_verdicts.npz) or an earlier run's condition_data.npz. "": none. Seeded with the
+    # cylinders policy's verdicts, the paper preset's DAgger phase kept eval_stairs and
+    # eval_stairs_side at 36.7 and 46.7 % success (0 and 0 % without); its policy still stops
+    # (1.05 m of progress per arena episode; docs/results/2026-12-01-path-condition).
     condition_seed_data: str = ""
     checkpoint_every_s: float = 60.0  # wall-clock seconds between checkpoints
     keep_checkpoints: int = 3

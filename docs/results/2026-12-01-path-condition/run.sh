@@ -55,4 +55,15 @@ PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylin
   --policy $SEEDED --out $D/condition_on_guides_learned_seeded
 leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint $SEEDED --workers 2 \
   --no-progress --out $D/pillars/train_paper_learned_seeded
+# the paper preset trained again, from scratch, against the seeded phase's final condition (fixed)
+# leas train --preset paper --reachability learned --condition-weights $SEEDED/condition.npz \
+#   --out runs/paper_seeded_geometric --no-progress
+AGAIN=$D/train_paper_seeded_geometric
+PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $AGAIN --starts 256 --workers 2 \
+  --spawns condition --out $D/guides/seeded_geometric/condition
+leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $AGAIN \
+  --workers 2 --no-progress --out $D/evaluate_seeded_geometric
+leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint $AGAIN --workers 2 \
+  --no-progress --out $D/pillars/train_paper_seeded_geometric
+leas arena-check --checkpoint $AGAIN --episodes 1024 --out $D/arena_check_seeded_geometric
 find $D -name guides.npz -delete   # 0.3-2.8 MB each, remade above

@@ -14,6 +14,7 @@ PYTHONPATH=$PWD python benchmarks/condition_from_paths.py --episodes 1024 --hold
 mkdir -p $D/refit_path80 && cp $D/refit_per_pose/teacher_guides_0.npz $D/refit_path80/
 PYTHONPATH=$PWD python benchmarks/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
   --path-sensitivity 0.8 --weights-out $D/train_paper_paths80/condition.npz --out $D/refit_path80
+cp $D/refit_per_pose/teacher_guides_0.npz /tmp/teacher_guides_0.npz   # reused by the second round below
 rm $D/refit_per_pose/teacher_guides_0.npz $D/refit_path80/teacher_guides_0.npz
 # training with each (80 M geometric steps, seed 0); policies and configs kept in $D/train_paper_paths*,
 # whose condition.npz `load_policy` reads (the weights were given by their path at training time)
@@ -66,4 +67,10 @@ leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas -
 leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint $AGAIN --workers 2 \
   --no-progress --out $D/pillars/train_paper_seeded_geometric
 leas arena-check --checkpoint $AGAIN --episodes 1024 --out $D/arena_check_seeded_geometric
+# a second outer round, refit only: the retrained policy's verdicts with the teacher's
+mkdir -p $D/refit_round2 && cp /tmp/teacher_guides_0.npz $D/refit_round2/teacher_guides_1.npz
+PYTHONPATH=$PWD python benchmarks/condition_from_paths.py --teacher $AGAIN $CYLINDERS \
+  --weights $SEEDED/condition.npz --episodes 1024 --holdout 256 --workers 2 \
+  --weights-out /tmp/round2_condition.npz --out $D/refit_round2
+rm $D/refit_round2/teacher_guides_*.npz $D/refit_round2/path_verdicts.npz
 find $D -name guides.npz -delete   # 0.3-2.8 MB each, remade above

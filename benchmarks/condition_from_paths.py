@@ -92,21 +92,12 @@ def path_outcomes(rejected, last_valid, horizon: int) -> dict:
     }
 
 
-def rates(predicted: np.ndarray, truth: np.ndarray) -> dict:
-    """Sensitivity and specificity of bool verdicts against bool truth, with 95 % intervals."""
-    from common import wilson
+def path_threshold(minima: np.ndarray, target: float) -> float:
+    """The largest threshold that lets at least `target` of the prefixes whose lowest logits
+    are `minima` [K] (`prefix_minima`) pass whole."""
+    from leas_jax.feasibility.fit import threshold_for
 
-    predicted, truth = np.asarray(predicted, bool), np.asarray(truth, bool)
-    tp, pos = int((predicted & truth).sum()), int(truth.sum())
-    tn, neg = int((~predicted & ~truth).sum()), int((~truth).sum())
-    return {
-        "sensitivity": tp / pos if pos else float("nan"),
-        "sensitivity_95ci": list(wilson(tp, pos)),
-        "specificity": tn / neg if neg else float("nan"),
-        "specificity_95ci": list(wilson(tn, neg)),
-        "feasible": pos,
-        "infeasible": neg,
-    }
+    return threshold_for(minima, np.ones(len(minima), bool), target)
 
 
 def guide_logits(params, field, reach, guides) -> list[np.ndarray]:
@@ -229,11 +220,11 @@ def main(argv=None) -> dict:
 
     import jax.numpy as jnp
     from guide_failures import cell_kinds, kind_at
+    from reachability_validation import rates
 
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.env.learned_weights import load_params, resolve_weights, save_params
     from leas_jax.feasibility import FitConfig, features_of, fit, predict
-    from leas_jax.feasibility.fit import threshold_for
     from leas_jax.feasibility.spawns import arena_field
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import learned_condition_env
@@ -277,10 +268,13 @@ def main(argv=None) -> dict:
     labels = np.concatenate([path_labels, anchor_labels])
     config = FitConfig(refresh_steps=args.steps)
     params, info = fit(features_of(base, field, poses, reach), labels, config, init=base, reach=reach)
+    fitted_minima = {  # the logits do not depend on the threshold
+        name: prefix_minima(guide_logits(weights, field, reach, fitted_guides), fitted_lvi, VERDICT_HORIZON)
+        for name, weights in (("before", base), ("after", params))
+    }
     if args.path_sensitivity is not None:
-        minima = prefix_minima(guide_logits(params, field, reach, fitted_guides), fitted_lvi, VERDICT_HORIZON)
         info["per_pose_threshold"] = info["threshold"]
-        info["threshold"] = threshold_for(minima, np.ones(len(minima), bool), args.path_sensitivity)
+        info["threshold"] = path_threshold(fitted_minima["after"], args.path_sensitivity)
         params["threshold"] = jnp.asarray(info["threshold"], jnp.float32)
     save_params(
         Path(args.weights_out),
@@ -300,9 +294,9 @@ def main(argv=None) -> dict:
     )
 
     cells = cell_kinds(arena.text)
-    fitted_minima = {
-        name: prefix_minima(guide_logits(weights, field, reach, fitted_guides), fitted_lvi, VERDICT_HORIZON)
-        for name, weights in (("before", base), ("after", params))
+    holdout_samples = {
+        path: verdict_samples(guides, lvi, np.random.default_rng(args.seed + 1), args.covered_per_guide)
+        for path, (_, _, guides, lvi) in planned.items()
     }
     conditions = {}
     for name, weights in (("before", base), ("after", params)):
@@ -318,13 +312,10 @@ def main(argv=None) -> dict:
             )
             trade = []
             for target in (0.5, 0.7, 0.8, 0.9, 0.95):
-                minima = fitted_minima[name]
-                threshold = threshold_for(minima, np.ones(len(minima), bool), target)
+                threshold = path_threshold(fitted_minima[name], target)
                 at = path_outcomes([lg < threshold for lg in logits], holdout_lvi, VERDICT_HORIZON)
                 trade.append({"path_sensitivity": target, "threshold": threshold, **at})
-            holdout_poses, holdout_labels = verdict_samples(
-                holdout_guides, holdout_lvi, np.random.default_rng(args.seed + 1), args.covered_per_guide
-            )
+            holdout_poses, holdout_labels = holdout_samples[path]
             conditions[name][path] = {
                 **outcome,
                 "threshold": float(weights["threshold"]),
@@ -353,7 +344,6 @@ def main(argv=None) -> dict:
         "fit": info,
         "conditions": conditions,
     }
-    out.mkdir(parents=True, exist_ok=True)
     (out / "condition_from_paths.md").write_text(markdown(report))
     save("condition_from_paths", report, load_before, out)
     print(markdown(report))

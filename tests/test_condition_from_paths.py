@@ -4,7 +4,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 
@@ -32,13 +31,12 @@ def test_path_outcomes_count_ended_covered_and_stopped_failed_guides():
     }
 
 
-def test_rates_are_sensitivity_and_specificity_with_intervals():
-    r = cfp.rates(np.array([1, 1, 0, 0, 1], bool), np.array([1, 1, 1, 0, 0], bool))
-    assert r["sensitivity"] == pytest.approx(2 / 3) and r["specificity"] == pytest.approx(1 / 2)
-    assert r["feasible"] == 3 and r["infeasible"] == 2
-    for key in ("sensitivity", "specificity"):
-        lo, hi = r[f"{key}_95ci"]
-        assert 0.0 <= lo < r[key] < hi <= 1.0
+def test_path_threshold_lets_the_target_share_of_prefixes_pass():
+    minima = np.array([-3.0, -1.0, 0.5, 2.0])
+    assert cfp.path_threshold(minima, 1.0) == -3.0  # every prefix passes
+    assert cfp.path_threshold(minima, 0.75) == -1.0  # three of four
+    assert cfp.path_threshold(minima, 0.5) == 0.5
+    assert (minima >= cfp.path_threshold(minima, 0.5)).mean() >= 0.5
 
 
 def test_prefix_minima_read_only_the_surely_feasible_prefix():

@@ -2,12 +2,15 @@
 
 For a trained policy (deterministic), run `--starts` episodes from the env's own random
 resets on its training arena (`leas_jax.eval.geometric.arena_episodes`, 400 steps), plan
-every guide with the contact generator, and for each guide it does not cover fully
+every guide with the contact generator (`--upper-bodies` sets its
+`GeneratorConfig.upper_bodies`; "half_sitting" is the paper's rigid upper body), and for each guide it does not cover fully
 describe the planning pose where it stopped (the first one after `last_valid_index`):
 
 - the arena cell it lies in, by kind (the `# cell (i, j) [...]: kind` comments that
   `leas terrain generate` writes; "unknown" on other terrains);
 - the guide's speed and yaw rate over the 0.5 s before it;
+- why the generator stopped there (`ContactGenerator.stop_reasons`): the check that rejected
+  most of the postures it tried at that pose ("leg IK", "terrain collision: arm", ...);
 - with `--what-if`, whether the same guide, re-planned with each of a few other generator
   settings (`what_if_configs`) or slowed down, passes it.
 
@@ -87,8 +90,15 @@ def slowed(guide: np.ndarray, factor: int) -> np.ndarray:
     return np.stack([np.interp(fine, t, c) for c in (guide[:, 0], guide[:, 1], guide[:, 2], yaw)], axis=1)
 
 
+def main_reason(reasons: dict) -> str:
+    """The check that rejected most postures at a failure ("none" when nothing was tried)."""
+    return max(reasons, key=reasons.get) if reasons else "none"
+
+
 def main(argv=None) -> dict:
     from common import add_out_argument, load_average, save, wilson
+
+    from leas_jax.contacts.planner.config import GeneratorConfig
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--policy", default="checkpoints/leas_talos", help="run directory or policy.ckpt")
@@ -97,6 +107,11 @@ def main(argv=None) -> dict:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--spawns", choices=["policy", "condition", "generator"], default="policy")
     parser.add_argument(
+        "--upper-bodies",
+        default=",".join(GeneratorConfig().upper_bodies),
+        help="comma-separated upper-body postures the generator may hold (GeneratorConfig.upper_bodies)",
+    )
+    parser.add_argument(
         "--what-if", action="store_true", help="re-plan the failed guides with other settings"
     )
     parser.add_argument(
@@ -104,9 +119,13 @@ def main(argv=None) -> dict:
     )
     add_out_argument(parser)
     args = parser.parse_args(argv)
+    try:
+        base = GeneratorConfig(upper_bodies=tuple(name for name in args.upper_bodies.split(",") if name))
+    except ValueError as error:
+        parser.error(f"--upper-bodies: {error}")
     load_before = load_average()
 
-    from leas_jax.contacts.planner.config import GeneratorConfig
+    from leas_jax.contacts.planner.generator import ContactGenerator
     from leas_jax.contacts.validation.pool import validate_paths
     from leas_jax.eval.geometric import arena_episodes
     from leas_jax.feasibility.spawns import arena_field
@@ -122,7 +141,6 @@ def main(argv=None) -> dict:
     field = arena_field(arena, env, workers=args.workers)
     episodes = arena_episodes(policy, field, n=args.starts, seed=args.seed)
     guides = [episodes.poses[k, : episodes.lengths[k]].astype(np.float64) for k in range(args.starts)]
-    base = GeneratorConfig()
     results = validate_paths(
         arena, guides, env.timestep, workers=args.workers, config=base, return_plans=False
     )
@@ -130,9 +148,11 @@ def main(argv=None) -> dict:
     failed = [k for k in range(args.starts) if coverage[k] < 1.0]
     cells = cell_kinds(arena.text)
     failures = []
+    explainer = ContactGenerator(arena, base)
     for k in failed:
         index = failing_index(results[k].last_valid_index, len(guides[k]), base.stride)
         speed, yaw_rate = motion_before(guides[k], index, env.timestep)
+        _, reasons = explainer.stop_reasons(guides[k], env.timestep)
         failures.append(
             {
                 "start": k,
@@ -142,6 +162,8 @@ def main(argv=None) -> dict:
                 "cell": kind_at(cells, guides[k][index, :2]),
                 "speed": speed,
                 "yaw_rate": yaw_rate,
+                "reasons": dict(reasons),
+                "reason": main_reason(reasons),
             }
         )
     what_if = {}
@@ -168,6 +190,7 @@ def main(argv=None) -> dict:
     report = {
         "policy": str(args.policy),
         "terrain": arena.name,
+        "upper_bodies": list(base.upper_bodies),
         "spawns": env.spawns,
         "starts": args.starts,
         "seed": args.seed,
@@ -180,6 +203,10 @@ def main(argv=None) -> dict:
         "valid_fraction": float(episodes.valid_fraction),
         "failures": failures,
         "failures_by_cell": dict(Counter(f["cell"] for f in failures).most_common()),
+        "failures_by_reason": dict(Counter(f["reason"] for f in failures).most_common()),
+        "failures_with_an_arm_collision": int(
+            sum(any(name.endswith(": arm") for name in f["reasons"]) for f in failures)
+        ),
         "cells_visited": dict(
             Counter(kind_at(cells, p[:2]) for g in guides for p in g[:: base.stride]).most_common()
         ),
@@ -205,6 +232,7 @@ def markdown(report: dict) -> str:
     lo, hi = report["full_coverage_95ci"]
     lines = [
         f"Policy {report['policy']} on {report['terrain']}, spawns {report['spawns']}, "
+        f"generator upper bodies {', '.join(report['upper_bodies'])}, "
         f"{report['starts']} starts (seed {report['seed']}): "
         f"{100 * report['full_coverage']:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}] of guides fully covered, "
         f"mean coverage {100 * report['mean_coverage']:.1f} %; {report['failed_at_first_pose']} guides "
@@ -218,6 +246,17 @@ def markdown(report: dict) -> str:
     for kind, count in report["failures_by_cell"].items():
         lines.append(f"| {kind} | {count} | {report['cells_visited'].get(kind, 0)} |")
     if report["failures"]:
+        lines += [
+            "",
+            "| why it stopped (the check rejecting most postures there) | failed guides |",
+            "|---|---|",
+        ]
+        lines += [f"| {reason} | {count} |" for reason, count in report["failures_by_reason"].items()]
+        lines += [
+            "",
+            f"Failed guides where an arm or gripper met the terrain or the legs at the failure: "
+            f"{report['failures_with_an_arm_collision']} / {len(report['failures'])}.",
+        ]
         speed = np.array([f["speed"] for f in report["failures"]])
         yaw = np.array([f["yaw_rate"] for f in report["failures"]])
         lines += [

@@ -117,3 +117,24 @@ def test_save_records_machine_load_and_commit(tmp_path):
         assert set(record[key]) == {"1min", "5min", "15min"}
     assert len(record["git"]["commit"]) == 40 and isinstance(record["git"]["dirty"], bool)
     assert not list(path.parent.glob("*.partial"))
+
+
+def test_guide_failures_report_names_why_the_generator_stopped():
+    import guide_failures
+
+    assert guide_failures.main_reason({"leg IK": 2, "terrain collision: arm": 5}) == "terrain collision: arm"
+    assert guide_failures.main_reason({}) == "none"
+    failure = {"start": 0, "cell": "wall", "speed": 0.1, "yaw_rate": 0.0, "reason": "terrain collision: arm"}
+    failure["reasons"] = {"terrain collision: arm": 5}
+    report = {
+        "policy": "p", "terrain": "t", "spawns": "condition", "upper_bodies": ["half_sitting"],
+        "starts": 2, "seed": 0, "full_coverage": 0.5, "full_coverage_95ci": [0.1, 0.9],
+        "mean_coverage": 0.7, "failed_at_first_pose": 0, "mean_progress_m": 1.0, "valid_fraction": 1.0,
+        "failures": [failure], "failures_by_cell": {"wall": 1}, "cells_visited": {"wall": 10},
+        "failures_by_reason": {"terrain collision: arm": 1}, "failures_with_an_arm_collision": 1,
+        "what_if": {},
+    }  # fmt: skip
+    text = guide_failures.markdown(report)
+    assert "upper bodies half_sitting" in text
+    assert "| terrain collision: arm | 1 |" in text
+    assert "met the terrain or the legs at the failure: 1 / 1" in text

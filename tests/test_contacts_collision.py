@@ -29,11 +29,12 @@ def test_fast_placements_match_pinocchio(talos):
     for _ in range(5):
         rot, root, legs, _ = _standing(talos, yaw=rng.uniform(-3, 3))
         legs = legs + rng.normal(0, 0.2, size=legs.shape)
-        q = talos.configuration(root, rot, legs)
-        fast = robot.placements_fast(talos, rot, root, legs)
-        ref = robot.placements_pinocchio(talos, q)
-        np.testing.assert_allclose(fast[0], ref[0], atol=1e-12)
-        np.testing.assert_allclose(fast[1], ref[1], atol=1e-12)
+        for upper in talos.upper_refs:
+            q = talos.configuration(root, rot, legs, upper)
+            fast = robot.placements_fast(talos, rot, root, legs, upper)
+            ref = robot.placements_pinocchio(talos, q)
+            np.testing.assert_allclose(fast[0], ref[0], atol=1e-12)
+            np.testing.assert_allclose(fast[1], ref[1], atol=1e-12)
 
 
 def test_standing_on_ground_is_free_and_sinking_collides(talos):

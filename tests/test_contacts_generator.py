@@ -213,8 +213,9 @@ def test_crouched_walk_is_covered_and_too_low_stops():
 def test_guide_too_high_stops():
     guide = straight(0.0, 4.0)
     guide[:, 2] = H + np.clip((guide[:, 0] - 2.0) * 0.5, 0.0, 0.4)  # rises from x = 2
-    plan = plan_contacts(FLAT, guide, DT)
+    plan, why = ContactGenerator(FLAT).stop_reasons(guide, DT)
     assert plan.coverage < 1.0
+    assert set(why) == {"root height"}  # every posture tried there: a leg overstretched
     # Legs (0.812 m hip to sole + 0.10 m root lowering) give out about 0.15 m above nominal.
     last_height = plan.guide[plan.last_valid_index, 2] - H
     assert 0.0 < last_height < 0.2
@@ -227,11 +228,45 @@ def test_single_support_with_a_shorter_root_shift_passes_a_pillar():
     3 cm inside the sole's edge, nearer the guide, shifts the root less and passes."""
     terrain = loads_terrain(HEAD + box([3, 0, -0.1], [8, 4, 0.2]) + box([2.0, 0.76, 0.7], [0.3, 0.3, 1.6]))
     guide = straight(0.0, 4.0)
-    centred = plan_contacts(terrain, guide, DT, GeneratorConfig(single_support_com_inset=None))
+    centred = plan_contacts(
+        terrain, guide, DT, GeneratorConfig(single_support_com_inset=None, upper_bodies=("half_sitting",))
+    )
     assert centred.coverage < 0.6
     plan = plan_contacts(terrain, guide, DT)
     assert plan.coverage == 1.0
     assert verify(plan).ok
+
+
+def test_arms_held_in_pass_a_pillar_beside_the_path():
+    """A pillar whose face is 0.48 m left of the path: the half-sitting gripper (0.55 m out)
+    meets it and the rigid upper body stops; the arms held in (0.38 m) pass, only there."""
+    terrain = loads_terrain(HEAD + box([3, 0, -0.1], [8, 4, 0.2]) + box([2.0, 0.63, 0.7], [0.3, 0.3, 1.6]))
+    guide = straight(0.0, 4.0)
+    rigid, why = ContactGenerator(terrain, GeneratorConfig(upper_bodies=("half_sitting",))).stop_reasons(
+        guide, DT
+    )
+    assert rigid.coverage < 0.5
+    assert 1.2 < x_at(rigid, rigid.last_valid_index) < 1.85
+    assert why.most_common(1)[0][0] == "terrain collision: arm"
+    plan, why = ContactGenerator(terrain).stop_reasons(guide, DT)
+    assert plan.coverage == 1.0 and not why
+    np.testing.assert_array_equal(plan.q, plan_contacts(terrain, guide, DT).q)
+    assert verify(plan).ok
+    talos = ContactGenerator(FLAT).projection.talos
+    shoulder_roll = talos.model.joints[talos.model.getJointId("arm_left_2_joint")].idx_q
+    held_in = plan.q[:, shoulder_roll] == talos.upper_refs["arms_in"][shoulder_roll]
+    x = plan.q[:, 0]
+    assert held_in.any() and not held_in[x < 1.0].any() and not held_in[x > 3.0].any()
+    np.testing.assert_array_equal(
+        plan.q[: len(rigid.q)][x[: len(rigid.q)] < 1.0], rigid.q[rigid.q[:, 0] < 1.0]
+    )
+
+
+def test_upper_bodies_must_be_known_postures():
+    with pytest.raises(ValueError, match="GeneratorConfig.upper_bodies"):
+        GeneratorConfig(upper_bodies=("arms_up",))
+    with pytest.raises(ValueError, match="GeneratorConfig.upper_bodies"):
+        GeneratorConfig(upper_bodies=())
 
 
 def test_turning_too_fast_stops():

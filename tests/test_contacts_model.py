@@ -63,6 +63,54 @@ def test_configuration_places_root(talos):
     np.testing.assert_allclose(q[19:], talos.q_ref[19:])  # upper body at half-sitting
 
 
+def test_arms_in_posture_is_narrower_within_limits_and_free_of_self_collision(talos):
+    """The arms held in (`UPPER_BODY_POSTURES["arms_in"]`): mirrored, within the joint limits,
+    free of self-collision on the SRDF's pairs, its arm and gripper boxes 0.1 m or more
+    nearer the root's x axis than at half-sitting."""
+    import itertools
+
+    arms_in = talos.upper_refs["arms_in"]
+    np.testing.assert_array_equal(talos.upper_refs["half_sitting"], talos.q_ref)
+    assert talos.joint_limit_violations(arms_in) == []
+
+    def joint(q, name):
+        return q[talos.model.joints[talos.model.getJointId(name)].idx_q]
+
+    for name, value in M.UPPER_BODY_POSTURES["arms_in"].items():
+        assert joint(arms_in, name) == value != joint(talos.q_ref, name)
+    assert joint(arms_in, "arm_right_2_joint") == -joint(arms_in, "arm_left_2_joint")
+    assert joint(arms_in, "arm_right_4_joint") == joint(arms_in, "arm_left_4_joint")
+    geom_model = talos.geom_model.copy()
+    geom_model.addAllCollisionPairs()
+    pin.removeCollisionPairs(talos.model, geom_model, talos.srdf_path)
+    geom_data = pin.GeometryData(geom_model)
+    data = talos.model.createData()
+
+    def widest_arm(q):
+        pin.updateGeometryPlacements(talos.model, data, geom_model, geom_data, q)
+        widest = 0.0
+        for g, obj in enumerate(geom_model.geometryObjects):
+            if obj.name.startswith(("arm_", "gripper_")):
+                obj.geometry.computeLocalAABB()
+                box = zip(obj.geometry.aabb_local.min_, obj.geometry.aabb_local.max_)
+                corners = np.array(list(itertools.product(*box)))
+                world = corners @ geom_data.oMg[g].rotation.T + geom_data.oMg[g].translation
+                widest = max(widest, float(np.abs(world[:, 1]).max()))
+        return widest
+
+    assert widest_arm(arms_in) < widest_arm(talos.q_ref) - 0.1
+    assert not pin.computeCollisions(talos.model, data, geom_model, geom_data, arms_in, False)
+    q = talos.configuration(np.array([1.0, 2.0, 1.0]), M.rotz(0.3), np.zeros((2, 6)), "arms_in")
+    np.testing.assert_allclose(q[19:], arms_in[19:])
+
+
+def test_upper_body_posture_outside_the_limits_is_refused(talos):
+    with pytest.raises(ValueError, match="arm_left_2_joint = -0.5 is outside"):
+        M.upper_body_reference(talos.model, talos.q_ref, {"arm_left_2_joint": -0.5})
+    with pytest.raises(ValueError, match="no joint 'arm_left_9_joint'"):
+        M.upper_body_reference(talos.model, talos.q_ref, {"arm_left_9_joint": 0.0})
+
+
 def test_joint_limit_violations(talos):
     q = talos.q_ref.copy()
     assert talos.joint_limit_violations(q) == []

@@ -82,4 +82,20 @@ class GeneratorConfig:
     # without solving the LP (equilibrium.flat_support_margin); 1.5 cm is ~5 x the CoM
     # margin of min_robustness, so the shortcut never accepts what the LP would reject
     flat_com_margin: float = 0.015
+    # Upper-body postures a posture may hold (`robot.model.UPPER_BODY_POSTURES`), in the order
+    # tried: the next one only where an arm or gripper of the one before meets the terrain.
+    # The arms held in clear walls and pillars 0.17 m nearer the root than half-sitting's
+    # (test_arms_held_in_pass_a_pillar_beside_the_path); ("half_sitting",) is the paper's
+    # rigid upper body.
+    upper_bodies: tuple[str, ...] = ("half_sitting", "arms_in")
     database: DatabaseConfig = field(default_factory=DatabaseConfig)
+
+    def __post_init__(self):
+        from leas_jax.contacts.robot.model import UPPER_BODY_POSTURES
+
+        unknown = [name for name in self.upper_bodies if name not in UPPER_BODY_POSTURES]
+        if not self.upper_bodies or unknown:
+            raise ValueError(
+                f"GeneratorConfig.upper_bodies must name one or more of {sorted(UPPER_BODY_POSTURES)}, "
+                f"got {self.upper_bodies!r}"
+            )

@@ -24,6 +24,7 @@ Settings: `config.GeneratorConfig`.
 from __future__ import annotations
 
 import math
+from collections import Counter
 
 import numpy as np
 
@@ -106,6 +107,9 @@ class ContactGenerator:
         cfg = self.config
         postures: list[ContactPosture] = []
         last_valid = -1
+        rejections = self.projection.rejections  # counted per planning pose (`stop_reasons`)
+        if rejections is not None:
+            rejections.clear()
         start = self._stance(guide[0])
         if start is not None:
             feet, first = start
@@ -115,12 +119,37 @@ class ContactGenerator:
             if len(guide) > 1 and (not indices or indices[-1] != len(guide) - 1):
                 indices.append(len(guide) - 1)
             for index in indices:
+                if rejections is not None:
+                    rejections.clear()
                 added = self.walking.advance(guide, timestep, index, feet)
                 if added is None:
                     break
                 postures.extend(added)
                 last_valid = index
         return self._make_plan(guide, timestep, postures, last_valid)
+
+    def stop_reasons(self, guide, timestep: float) -> tuple[ContactPlan, Counter]:
+        """A guide's plan, and why it stops: the checks that rejected the postures tried at
+        the planning pose it could not pass.
+
+        Host-only, not jittable. Counts are by check ("leg IK", "root height", "equilibrium",
+        "no foothold", "terrain collision: arm", "self collision: leg", ...; the body part
+        from `projection.body_part`); empty when the plan covers the whole guide. The plan
+        is the one `plan` gives.
+
+        Args:
+            guide: [T, 4] root poses (x, y, z, yaw), world frame.
+            timestep: s between guide poses.
+        """
+        self.projection.rejections = Counter()
+        try:
+            plan = self.plan(guide, timestep)
+            reasons = (
+                Counter() if plan.last_valid_index == len(plan.guide) - 1 else self.projection.rejections
+            )
+        finally:
+            self.projection.rejections = None
+        return plan, reasons
 
     def _make_plan(self, guide, timestep, postures, last_valid) -> ContactPlan:
         if postures:

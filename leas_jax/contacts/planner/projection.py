@@ -4,8 +4,10 @@ The stage every other stage of the generator calls (HPP's "projection" of a stat
 its contacts): the root follows the guide (yaw and height from it, lowered by at most
 `max_root_offset_z` if a leg would be overstretched, shifted horizontally by at most
 `max_root_offset_xy` to bring the CoM over the support), the legs reach their soles by
-analytic IK within the joint limits, and the posture must be free of terrain and self
-collision (coal) and in static equilibrium (hpp-centroidal-dynamics LP, docs/design.md §6).
+analytic IK within the joint limits, the upper body holds the first of
+`GeneratorConfig.upper_bodies` whose arms miss the terrain, and the posture must be free
+of terrain and self collision (coal) and in static equilibrium (hpp-centroidal-dynamics
+LP, docs/design.md §6).
 
 Host-only (Pinocchio, coal, hpp-centroidal-dynamics), not jittable.
 """
@@ -13,6 +15,7 @@ Host-only (Pinocchio, coal, hpp-centroidal-dynamics), not jittable.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,6 +52,16 @@ def placement_row(pos, rot) -> np.ndarray:
     return np.concatenate([pos, quat_xyzw_from_matrix_single(rot)])
 
 
+def body_part(geometry_name: str) -> str:
+    """The part of Talos a collision geometry belongs to: "arm" (arms and grippers),
+    "leg" (legs and feet) or "trunk" (torso, head, base)."""
+    if geometry_name.startswith(("arm_", "gripper_")):
+        return "arm"
+    if geometry_name.startswith("leg_"):
+        return "leg"
+    return "trunk"
+
+
 class PostureProjection:
     """Builds and checks postures of Talos on one terrain; holds its collision and LP state.
 
@@ -63,6 +76,9 @@ class PostureProjection:
     def __init__(self, terrain, talos, config: GeneratorConfig):
         self.config = config
         self.talos = talos
+        # None, or a Counter of the checks that rejected postures, by `rejection_name`
+        # (what `ContactGenerator.stop_reasons` reads); counting is off by default.
+        self.rejections: Counter | None = None
         self.robot = robot_collision(talos)
         self.terrain_objects = terrain_collision(terrain)
         self.equilibrium = HppEquilibrium(talos.mass, config.mu)
@@ -70,6 +86,12 @@ class PostureProjection:
             math.sqrt(leg.thigh**2 + leg.shin**2 + 2 * leg.thigh * leg.shin * math.cos(config.min_knee))
             for leg in talos.legs
         ]
+
+    def count_rejection(self, check: str, geometry: int | None = None) -> None:
+        """Count one rejected posture under `check` (with the body part for a collision)."""
+        if self.rejections is not None:
+            part = "" if geometry is None else f": {body_part(self.robot.names[geometry])}"
+            self.rejections[check + part] += 1
 
     def legs_ik(self, root_R, root_p, contacts) -> np.ndarray | None:
         """Leg joints [2, 6] placing each contact sole, or None (unreachable / joint limits).
@@ -128,19 +150,30 @@ class PostureProjection:
         target = support_centre if com_target is None else np.asarray(com_target)
         offsets = [None] if com_target is not None else [np.zeros(2), None]
         airs = [None] if air is None else [(air[0], *option) for option in air[1]]
-        for offset in offsets:
-            for one_air in airs:
-                built = self._build(
-                    guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, one_air
-                )
-                if built is not None:
-                    return built
+        # Each upper body is a fallback for the one before: tried only where an arm or gripper
+        # of that one met the terrain (another moves only the arms: any other check fails the
+        # same way). Where the first succeeds the posture is the one it alone would give.
+        for upper in self.config.upper_bodies:
+            arms_hit = False
+            for offset in offsets:
+                for one_air in airs:
+                    built, hit = self._build(
+                        guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, one_air, upper
+                    )
+                    if built is not None:
+                        return built
+                    arms_hit |= hit
+            if not arms_hit:
+                return None
         return None
 
-    def _build(self, guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air):
-        """One root offset (None: shift the CoM onto `target`) and one placement of the foot in
-        the air (None, or (side, pos [3], rot [3, 3], follows_root), see `posture`); all checks.
-        Returns a posture or None."""
+    def _build(self, guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air, upper):
+        """One root offset (None: shift the CoM onto `target`), one placement of the foot in
+        the air (None, or (side, pos [3], rot [3, 3], follows_root), see `posture`) and one
+        upper-body posture (a key of `talos.upper_refs`); all checks.
+
+        Returns:
+            (the posture or None, whether it failed because an arm or gripper met the terrain)."""
         cfg = self.config
         talos = self.talos
         iterations = 1 if offset is not None else 3
@@ -152,20 +185,23 @@ class PostureProjection:
             root_xy = guide_xy + shift
             z = self.root_height(guide_pose, root_xy, root_R, contacts)
             if z is None:
-                return None
+                self.count_rejection("root height")
+                return None, False
             root_p = np.array([root_xy[0], root_xy[1], z])
             leg_q = self.legs_ik(root_R, root_p, contacts)
             if leg_q is None:
-                return None
+                self.count_rejection("leg IK")
+                return None, False
             if air is not None:
                 side, pos, rot, follows_root = air
                 if follows_root:
                     pos = pos + np.array([shift[0], shift[1], 0.0])
                 solved = self.legs_ik(root_R, root_p, [(side, pos, rot)])
                 if solved is None:
-                    return None
+                    self.count_rejection("leg IK")
+                    return None, False
                 leg_q[side] = solved[side]
-            q = talos.configuration(root_p, root_R, leg_q)
+            q = talos.configuration(root_p, root_R, leg_q, upper)
             com = talos.com(q)
             if offset is None and it + 1 < iterations:
                 error = target - com[:2]
@@ -182,21 +218,27 @@ class PostureProjection:
                 # no static equilibrium (the centre of pressure would have to be the CoM's
                 # projection), the LP's robustness is < 0; rejected without the LP.
                 if -math.inf < margin < -_OUTSIDE_MARGIN and cfg.min_robustness >= 0.0:
-                    return None
+                    self.count_rejection("equilibrium")
+                    return None, False
             # Every check must pass, so their order changes no result: cheapest first
             # (terrain collision ~50 us, the LP ~300 us, self-collision ~100 us and rarely failing).
-            rot, pos = self.robot.placements_fast(talos, root_R, root_p, leg_q)
+            rot, pos = self.robot.placements_fast(talos, root_R, root_p, leg_q, upper)
             aabb = self.robot.world_aabb(rot, pos)
-            if self.robot.terrain_contacts(rot, pos, self.terrain_objects, aabb=aabb):
-                return None
+            hits = self.robot.terrain_contacts(rot, pos, self.terrain_objects, aabb=aabb)
+            if hits:
+                self.count_rejection("terrain collision", hits[0][0])
+                return None, bool(self.robot.on_arms[hits[0][0]])
             if margin < cfg.flat_com_margin:
                 self.equilibrium.set_contacts(points, normals)
                 if self.equilibrium.robustness(com) < cfg.min_robustness:
-                    return None
-            if self.robot.self_contacts(rot, pos, aabb=aabb):
-                return None
+                    self.count_rejection("equilibrium")
+                    return None, False
+            pairs = self.robot.self_contacts(rot, pos, aabb=aabb)
+            if pairs:
+                self.count_rejection("self collision", pairs[0][1])
+                return None, False
             feet = np.full((2, 7), np.nan)  # built for an accepted posture only
             for side, sole_pos, sole_rot in contacts:
                 feet[side] = placement_row(sole_pos, sole_rot)
-            return ContactPosture(q=q, feet=feet, guide_index=guide_index)
-        return None
+            return ContactPosture(q=q, feet=feet, guide_index=guide_index), False
+        return None, False

@@ -36,9 +36,11 @@ def initial_stance(
     right_target, right_yaw = footholds.nominal_placement(pose, RIGHT)
     left = footholds.first_candidate(LEFT, pose, left_target, left_yaw)
     if left is None:
+        projection.count_rejection("no foothold")
         return None
     right = footholds.first_candidate(RIGHT, pose, right_target, right_yaw, left)
     if right is None:
+        projection.count_rejection("no foothold")
         return None
     posture = projection.posture(pose, 0, [(LEFT, *left), (RIGHT, *right)])
     if posture is not None:

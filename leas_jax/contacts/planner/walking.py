@@ -143,6 +143,8 @@ class Walking:
                 if double is not None:
                     feet[side] = (pos, rot)
                     return [single, double], held_back
+        if tried == 0:
+            self.projection.count_rejection("no foothold")
         return None, held_back
 
     def step_either(self, guide, timestep, index: int, feet, order) -> list[ContactPosture] | None:

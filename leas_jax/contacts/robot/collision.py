@@ -120,8 +120,10 @@ class RobotCollision:
         parent: [G] Pinocchio joint of each geometry.
         joint_geom: [G, 4, 4] joint-to-geometry placements.
         self_pairs: [P, 2] geometry index pairs checked for self-collision.
-        rootMg_upper: [G, 4, 4] root-to-geometry placements at half-sitting (valid for
-            the geometries not on the legs).
+        rootMg_upper: {upper-body posture: [G, 4, 4]} root-to-geometry placements in each
+            of `talos.upper_refs` (valid for the geometries not on the legs).
+        on_arms: [G] whether a geometry is on an arm or gripper (what the upper-body
+            postures move).
         leg_of: [G] 0 / 1 for left / right leg geometries, -1 for the rest.
         leg_link: [G] link number 1..6 inside the leg, 0 for the rest.
     """
@@ -148,11 +150,14 @@ class RobotCollision:
             for g in talos.leg_geom_ids[side]:
                 self.leg_of[g] = side
                 self.leg_link[g] = int(self.names[g].split("_")[2])
-        # Root-frame placements of all geometries at half-sitting (root at the origin).
+        # Root-frame placements of all geometries in each upper-body posture (root at the origin).
         data = talos.model.createData()
         gd = pin.GeometryData(gm)
-        pin.updateGeometryPlacements(talos.model, data, gm, gd, talos.q_ref)
-        self.rootMg_upper = np.array([gd.oMg[g].homogeneous for g in range(len(self.names))])
+        self.rootMg_upper = {}
+        for upper, q_upper in talos.upper_refs.items():
+            pin.updateGeometryPlacements(talos.model, data, gm, gd, q_upper)
+            self.rootMg_upper[upper] = np.array([gd.oMg[g].homogeneous for g in range(len(self.names))])
+        self.on_arms = np.array([name.startswith(("arm_", "gripper_")) for name in self.names])
         self.self_pairs = self._self_pairs(talos)
         self._leg_geoms = np.nonzero(self.leg_of >= 0)[0]
         self._leg_side = self.leg_of[self._leg_geoms]
@@ -183,17 +188,23 @@ class RobotCollision:
         return np.array(sorted(set(pairs)), dtype=np.int64).reshape(-1, 2)
 
     def placements_fast(
-        self, talos: TalosModel, root_R: np.ndarray, root_p: np.ndarray, leg_q: np.ndarray
+        self,
+        talos: TalosModel,
+        root_R: np.ndarray,
+        root_p: np.ndarray,
+        leg_q: np.ndarray,
+        upper: str = "half_sitting",
     ) -> tuple[np.ndarray, np.ndarray]:
         """World placements of all geometries by NumPy forward kinematics.
 
-        The upper body is rigid at half-sitting, so its geometries follow the root;
+        The upper body is rigid in posture `upper`, so its geometries follow the root;
         leg geometries follow the chain of `ik.py` eq. (1)-(3).
 
         Args:
             talos: the model.
             root_R: [3, 3] world_R_root; root_p: [3] root position, world, m.
             leg_q: [2, 6] leg joints, rad.
+            upper: the upper body's posture, a key of `talos.upper_refs`.
 
         Returns:
             (R [G, 3, 3], p [G, 3]) world placements of the geometries.
@@ -201,7 +212,7 @@ class RobotCollision:
         oMroot = np.eye(4)
         oMroot[:3, :3] = root_R
         oMroot[:3, 3] = root_p
-        oMg = oMroot @ self.rootMg_upper
+        oMg = oMroot @ self.rootMg_upper[upper]
         frames = _legs_joint_frames(self._leg_hip, self._leg_thigh, self._leg_shin, leg_q)  # [2, 6, 4, 4]
         oMg[self._leg_geoms] = (
             oMroot @ frames[self._leg_side, self._leg_frame] @ self.joint_geom[self._leg_geoms]

@@ -3,8 +3,8 @@
 Host-only (Pinocchio, coal), not jittable. The robot is the full Talos of
 `example-robot-data` (`talos_reduced.urdf` + `talos.srdf`): a free-flyer root
 (`base_link`), q = [x, y, z, qx, qy, qz, qw, 32 joints] (nq = 39, quaternion
-**xyzw**, Pinocchio's order), upper body held at the half-sitting reference
-configuration.
+**xyzw**, Pinocchio's order), upper body rigid in one of `UPPER_BODY_POSTURES`: the
+half-sitting reference configuration, or the same with the arms held in.
 
 Leg kinematics (read from the model and checked at load, see `_leg_kinematics`):
 each leg is hip yaw (z), hip roll (x), hip pitch (y) meeting at one point
@@ -43,6 +43,25 @@ NQ = 39  # Talos free-flyer configuration size (7 + 32 joints)
 # along the sole normal for terrain collision; it equals the 5 mm contact tolerance
 # of docs/design.md §6 check 1.
 FOOT_CLEARANCE = 0.005  # m
+# Upper-body postures a posture may hold, by name: joint values that differ from
+# half-sitting (left arm; the right arm mirrors it: roll and yaw joints change sign).
+# "arms_in": shoulders pitched back and rolled in against the trunk, upper arms turned
+# out, elbows as bent as at half-sitting. The bounding boxes of the arms and grippers
+# reach 0.55 m to the side of the root at half-sitting, 0.38 m held in (the shoulders'
+# width), hands in front of the hips, still free of self-collision (7 mm from the torso
+# on the SRDF's pairs; tests/test_contacts_model.py). An arm or gripper meeting a wall,
+# pillar or platform edge beside the path was the most frequent reason the generator
+# stopped on the shipped policy's arena guides (docs/results/2026-12-02-arms-in).
+UPPER_BODY_POSTURES = {
+    "half_sitting": {},
+    "arms_in": {
+        "arm_left_1_joint": -0.30,  # shoulder, rad (half-sitting 0.258)
+        "arm_left_2_joint": 0.01,  # shoulder roll, rad (half-sitting 0.173; lower limit 0)
+        "arm_left_3_joint": 0.30,  # upper-arm yaw, rad (half-sitting 0)
+        "arm_left_4_joint": -0.60,  # elbow, rad (half-sitting -0.525)
+    },
+}
+_MIRRORED_ARM_JOINTS = ("arm_left_1_joint", "arm_left_2_joint", "arm_left_3_joint")  # sign flips on the right
 # Leg joint order inside a leg: hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle roll.
 _LEG_AXES = ("Z", "X", "Y", "Y", "Y", "X")
 
@@ -247,6 +266,7 @@ class TalosModel:
             FOOT_CLEARANCE along the sole normal).
         geom_data: pinocchio.GeometryData for `geom_model`.
         q_ref: [39] half-sitting reference configuration (root at the origin, yaw 0).
+        upper_refs: {name: [39]} `q_ref` with each of `UPPER_BODY_POSTURES`' joints set.
         mass: total mass, kg.
         sole_frame_ids: (left, right) Pinocchio frame ids of the sole frames.
         legs: (left, right) LegKinematics.
@@ -285,6 +305,10 @@ class TalosModel:
         q_ref[6] = 1.0
         self.q_ref = q_ref
         self.q_ref.setflags(write=False)
+        self.upper_refs = {
+            name: upper_body_reference(self.model, q_ref, joints)
+            for name, joints in UPPER_BODY_POSTURES.items()
+        }
         self.mass = float(pin.computeTotalMass(self.model))
         self.sole_frame_ids = tuple(self.model.getFrameId(name) for name in SOLE_FRAMES)
         self.legs = tuple(
@@ -300,18 +324,19 @@ class TalosModel:
         )
         self.geom_data = pin.GeometryData(self.geom_model)
 
-    def configuration(self, root_pos, root_rot, leg_q) -> np.ndarray:
+    def configuration(self, root_pos, root_rot, leg_q, upper: str = "half_sitting") -> np.ndarray:
         """Full configuration from a root placement and the two legs' joints.
 
         Args:
             root_pos: [3] base_link position, world frame, m.
             root_rot: [3, 3] world_R_root.
             leg_q: [2, 6] (left, right) leg joints, rad, order hip yaw ... ankle roll.
+            upper: the upper body's posture, a key of `UPPER_BODY_POSTURES`.
 
         Returns:
-            [39] q: root xyz + quaternion xyzw, legs from `leg_q`, rest half-sitting.
+            [39] q: root xyz + quaternion xyzw, legs from `leg_q`, rest from `upper`.
         """
-        q = self.q_ref.copy()
+        q = self.upper_refs[upper].copy()
         q[:3] = root_pos
         q[3:7] = quat_xyzw_from_matrix_single(root_rot)
         for side in (LEFT, RIGHT):
@@ -362,6 +387,29 @@ class TalosModel:
             if value < lo - tol or value > hi + tol:
                 out.append((self.model.names[jid], float(value), float(lo), float(hi)))
         return out
+
+
+def upper_body_reference(model, q_ref: np.ndarray, joints: dict) -> np.ndarray:
+    """[39] `q_ref` with the left-arm joint values `joints` set and mirrored on the right arm.
+
+    Raises:
+        ValueError: a joint the model lacks, or a value outside its limits.
+    """
+    q = q_ref.copy()
+    for name, value in joints.items():
+        for side_name, side_value in (
+            (name, value),
+            (name.replace("_left_", "_right_"), -value if name in _MIRRORED_ARM_JOINTS else value),
+        ):
+            if not model.existJointName(side_name):
+                raise ValueError(f"upper-body posture: Talos has no joint {side_name!r}")
+            index = model.joints[model.getJointId(side_name)].idx_q
+            lo, hi = model.lowerPositionLimit[index], model.upperPositionLimit[index]
+            if not lo <= side_value <= hi:
+                raise ValueError(f"upper-body posture: {side_name} = {side_value} is outside [{lo}, {hi}]")
+            q[index] = side_value
+    q.setflags(write=False)
+    return q
 
 
 def _leg_kinematics(model, prefix: str, sole_frame: str) -> LegKinematics:

@@ -20,8 +20,8 @@
     python benchmarks/feasibility_condition.py [--train-poses 16000] [--workers 2]
         [--weights checkpoints/feasibility/walking.npz] [--out docs/results/...]
 
-Writes <out>/feasibility_condition.json and feasibility_condition.md (and
-results/feasibility_condition.json).
+Writes <out>/feasibility_condition.json (with the machine, load and commit) and
+feasibility_condition.md (default out: benchmarks/results).
 """
 
 from __future__ import annotations
@@ -165,7 +165,7 @@ def markdown(report: dict) -> str:
 
 
 def main(argv=None) -> None:
-    from common import machine, save
+    from common import RESULTS, load_average, save
 
     from leas_jax.env import EnvConfig, ReachabilityConfig, heightfield_from_terrain
     from leas_jax.env import learned_feasibility as lf
@@ -201,6 +201,7 @@ def main(argv=None) -> None:
     if len({args.train_seed, args.test_seed}) < 2 or len({args.policy_train_seed, args.policy_seed}) < 2:
         parser.error("the training and validation seeds must differ (the validation poses must be fresh)")
 
+    load_before = load_average()
     began = time.perf_counter()
     terrain = load_terrain(rc.ARENA)
     policy = load_policy(args.policy) if args.policy_poses or args.policy_train_poses else None
@@ -276,15 +277,10 @@ def main(argv=None) -> None:
         )
         print(markdown({**report, "validation": {}}).splitlines()[-1])
     report["seconds"] = round(time.perf_counter() - began, 1)
-    save("feasibility_condition", report)
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "feasibility_condition.json").write_text(
-            json.dumps({**report, "machine": machine()}, indent=2)
-        )
-        (out / "feasibility_condition.md").write_text(markdown(report))
-        print(f"wrote {out}/feasibility_condition.json and .md")
+    out = Path(args.out) if args.out else RESULTS
+    save("feasibility_condition", report, load_before, out)
+    (out / "feasibility_condition.md").write_text(markdown(report))
+    print(f"wrote {out}/feasibility_condition.json and .md")
 
 
 if __name__ == "__main__":

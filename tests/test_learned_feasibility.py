@@ -237,3 +237,39 @@ def test_train_command_takes_other_condition_weights(tmp_path):
         )
     with pytest.raises(UsageError, match="--condition-weights is for --reachability learned"):
         config_from_args(parser.parse_args([*base, "--condition-weights", str(weights)]))
+
+
+def test_feasibility_condition_benchmark_runs_end_to_end(tmp_path, monkeypatch):
+    """benchmarks/feasibility_condition.py on tiny settings: labels (cached under tmp_path),
+    fit, weights with their data key, and the report with the machine, load and commit."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    import feasibility_condition as bench
+    import feasibility_data as fd
+
+    monkeypatch.setattr(fd, "cache_file", lambda name, key: tmp_path / f"labels_{name}_{key[:16]}.npz")
+    weights = tmp_path / "w.npz"
+    report = tmp_path / "report"
+    bench.main(
+        ["--train-poses", "40", "--test-poses", "20", "--policy-train-poses", "0", "--policy-poses", "0"]
+        + [
+            "--workers",
+            "0",
+            "--steps",
+            "20",
+            "--cost-envs",
+            "0",
+            "--weights",
+            str(weights),
+            "--out",
+            str(report),
+        ]
+    )
+    saved = json.loads((report / "feasibility_condition.json").read_text())
+    assert {"machine", "git", "load_average_before"} <= set(saved)
+    learned = saved["validation"]["fresh"]["learned"]
+    assert learned["tp"] + learned["fn"] + learned["fp"] + learned["tn"] == 20
+    params, metadata = lf.load_params(weights)
+    assert metadata["data_key"] == saved["data_key"]
+    assert "| fresh |" in (report / "feasibility_condition.md").read_text()

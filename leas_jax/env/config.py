@@ -72,7 +72,9 @@ class ReachabilityConfig:
     # 0.3-0.55 m from a wall or pillar pass the trunk term and the generator stops there with a
     # gripper in the obstacle. Each hand disk, of radius hand_radius centred at
     # (hand_forward, ±hand_lateral) in the root frame, must hold no terrain above
-    # z + hand_bottom. None disables the term. Calibrated: 0.13 m.
+    # z + hand_bottom. None disables the term. Calibrated: 0.13 m, against the generator with
+    # its arms rigid at half-sitting; it now holds them in (0.38 m sideways) where they would
+    # meet the terrain (GeneratorConfig.upper_bodies), so the term is stricter than it.
     hand_radius: float | None = 0.13
     hand_forward: float = 0.12  # m, hand disk centres ahead of the root (the grippers span 0.04-0.21 m)
     hand_lateral: float = 0.45  # m, hand disk centres beside the root (the grippers span 0.35-0.55 m)

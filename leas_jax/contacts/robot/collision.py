@@ -2,7 +2,7 @@
 
 Host-only (coal, NumPy), not jittable. Geometry placements come either from
 Pinocchio (`placements_pinocchio`, used by the verifier) or from a NumPy forward
-kinematics of the legs with the upper body rigid at half-sitting
+kinematics of the legs with the upper body rigid in one of `model.UPPER_BODY_POSTURES`
 (`placements_fast`, used by the generator; tests check that both agree). Each
 geometry's local bounding box is moved to the world frame and tested against the
 terrain boxes' bounding boxes first, so that coal only sees pairs that may touch.

@@ -42,3 +42,19 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
 #    24 000 poses, 3 min with 2 workers on the idle machine).
 PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 \
   --weights $D/walking_arms_in.npz --out $D/feasibility
+
+# 6. The paper preset trained with the relabelled condition, seeds 0-2 (21 min each), and
+#    evaluated like the policies above (own arena guides, scenarios, pillars, arena check).
+for S in 0 1 2; do
+  leas train --preset paper --seed $S --reachability learned --condition-weights $D/walking_arms_in.npz \
+    --out runs/paper_learned_arms_s$S --no-progress
+  T=$D/train_paper_learned_arms_s$S
+  mkdir -p $T && cp runs/paper_learned_arms_s$S/config.json runs/paper_learned_arms_s$S/policy.ckpt $T/
+  python benchmarks/guide_failures.py --policy $T --starts 256 --workers 2 --spawns condition \
+    --out $D/learned_arms_s$S
+  leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $T \
+    --workers 2 --no-progress --out $D/evaluate_learned_arms_s$S
+  leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint $T --workers 2 \
+    --no-progress --out $D/pillars/train_paper_learned_arms_s$S
+  leas arena-check --checkpoint $T --episodes 1024 --out $D/arena_check_learned_arms_s$S
+done

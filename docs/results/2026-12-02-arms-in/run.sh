@@ -58,3 +58,13 @@ for S in 0 1 2; do
     --no-progress --out $D/pillars/train_paper_learned_arms_s$S
   leas arena-check --checkpoint $T --episodes 1024 --out $D/arena_check_learned_arms_s$S
 done
+
+# 7. The shipped policy's failed guides re-planned with other generator settings (3 min).
+python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
+  --spawns condition --what-if --out $D/shipped/what_if
+
+# 8. `make run` from a fresh clone (8 min with the environment installed), then its
+#    fine-tuned policy's own arena guides (run from the clone's root, where runs/quick is).
+#   time make run
+#   python benchmarks/guide_failures.py --policy runs/quick/planner --starts 256 --workers 2 \
+#     --spawns condition --out $D/make_run/own_guides

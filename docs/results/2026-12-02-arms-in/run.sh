@@ -63,6 +63,10 @@ done
 python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
   --spawns condition --what-if --out $D/shipped/what_if
 
+# 7b. The same with resets at generator-verified poses (the spawns' verdicts rebuilt once, 2.5 min).
+python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
+  --spawns generator --out $D/shipped/verified_spawns
+
 # 8. `make run` from a fresh clone (8 min with the environment installed), then its
 #    fine-tuned policy's own arena guides (run from the clone's root, where runs/quick is).
 #   time make run

@@ -134,7 +134,7 @@ class ContactGenerator:
 
         Host-only, not jittable. Counts are by check ("leg IK", "root height", "equilibrium",
         "no foothold", "terrain collision: arm", "self collision: leg", ...; the body part
-        from `projection.body_part`); empty when the plan covers the whole guide. The plan
+        from `robot.collision.body_part`); empty when the plan covers the whole guide. The plan
         is the one `plan` gives.
 
         Args:

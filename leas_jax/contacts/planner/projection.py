@@ -52,16 +52,6 @@ def placement_row(pos, rot) -> np.ndarray:
     return np.concatenate([pos, quat_xyzw_from_matrix_single(rot)])
 
 
-def body_part(geometry_name: str) -> str:
-    """The part of Talos a collision geometry belongs to: "arm" (arms and grippers),
-    "leg" (legs and feet) or "trunk" (torso, head, base)."""
-    if geometry_name.startswith(("arm_", "gripper_")):
-        return "arm"
-    if geometry_name.startswith("leg_"):
-        return "leg"
-    return "trunk"
-
-
 class PostureProjection:
     """Builds and checks postures of Talos on one terrain; holds its collision and LP state.
 
@@ -90,7 +80,7 @@ class PostureProjection:
     def count_rejection(self, check: str, geometry: int | None = None) -> None:
         """Count one rejected posture under `check` (with the body part for a collision)."""
         if self.rejections is not None:
-            part = "" if geometry is None else f": {body_part(self.robot.names[geometry])}"
+            part = "" if geometry is None else f": {self.robot.parts[geometry]}"
             self.rejections[check + part] += 1
 
     def legs_ik(self, root_R, root_p, contacts) -> np.ndarray | None:
@@ -227,7 +217,7 @@ class PostureProjection:
             hits = self.robot.terrain_contacts(rot, pos, self.terrain_objects, aabb=aabb)
             if hits:
                 self.count_rejection("terrain collision", hits[0][0])
-                return None, bool(self.robot.on_arms[hits[0][0]])
+                return None, self.robot.parts[hits[0][0]] == "arm"
             if margin < cfg.flat_com_margin:
                 self.equilibrium.set_contacts(points, normals)
                 if self.equilibrium.robustness(com) < cfg.min_robustness:

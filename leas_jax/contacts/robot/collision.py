@@ -107,6 +107,16 @@ def _bvh(coal, triangles: np.ndarray):
     return model
 
 
+def body_part(geometry_name: str) -> str:
+    """The part of Talos a collision geometry belongs to: "arm" (arms and grippers),
+    "leg" (legs and feet) or "trunk" (torso, head, base)."""
+    if geometry_name.startswith(("arm_", "gripper_")):
+        return "arm"
+    if geometry_name.startswith("leg_"):
+        return "leg"
+    return "trunk"
+
+
 class RobotCollision:
     """Robot-side collision data derived from a TalosModel.
 
@@ -122,8 +132,8 @@ class RobotCollision:
         self_pairs: [P, 2] geometry index pairs checked for self-collision.
         rootMg_upper: {upper-body posture: [G, 4, 4]} root-to-geometry placements in each
             of `talos.upper_refs` (valid for the geometries not on the legs).
-        on_arms: [G] whether a geometry is on an arm or gripper (what the upper-body
-            postures move).
+        parts: [G] the part of Talos each geometry belongs to (`body_part`): "arm" is
+            what the upper-body postures move.
         leg_of: [G] 0 / 1 for left / right leg geometries, -1 for the rest.
         leg_link: [G] link number 1..6 inside the leg, 0 for the rest.
     """
@@ -157,7 +167,7 @@ class RobotCollision:
         for upper, q_upper in talos.upper_refs.items():
             pin.updateGeometryPlacements(talos.model, data, gm, gd, q_upper)
             self.rootMg_upper[upper] = np.array([gd.oMg[g].homogeneous for g in range(len(self.names))])
-        self.on_arms = np.array([name.startswith(("arm_", "gripper_")) for name in self.names])
+        self.parts = [body_part(name) for name in self.names]
         self.self_pairs = self._self_pairs(talos)
         self._leg_geoms = np.nonzero(self.leg_of >= 0)[0]
         self._leg_side = self.leg_of[self._leg_geoms]

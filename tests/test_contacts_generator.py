@@ -356,7 +356,8 @@ def test_soles_turn_to_a_narrow_bridge_axis():
     guide's yaw take 0.183 m across each, so they fit only staggered; soles turned to the
     beam's axis fit; with the turning disabled this plan stops on the bridge. (At 0.2 rad
     staggered soles at the guide's yaw cross too, once a sole may rest across the
-    platform's and the bridge's coplanar tops.)"""
+    platform's and the bridge's coplanar tops; at 0.3 rad they cross too with the step
+    fallback to the place under the root, `fallback_lookahead`, so it is off here.)"""
     bridge = loads_terrain(
         HEAD
         + box([0.5, 0, -0.1], [3, 4, 0.2])
@@ -374,7 +375,7 @@ def test_soles_turn_to_a_narrow_bridge_axis():
         2 * (on_bridge[:, 6] * on_bridge[:, 5]), 1 - 2 * on_bridge[:, 5] ** 2
     )  # quaternion xyzw
     assert len(on_bridge) >= 4 and np.abs(yaws).max() < 1e-6
-    stiff = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0))
+    stiff = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0, fallback_lookahead=None))
     assert stiff.coverage < 1.0
     assert 2.0 < x_at(stiff, stiff.last_valid_index) < 4.0
 
@@ -425,3 +426,22 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
         circuit, data["guide"], float(data["timestep"]), GeneratorConfig(swing_clearance=0.0)
     )
     assert held_under.last_valid_index == 160
+
+
+def test_a_step_falls_back_to_the_place_under_the_root():
+    """A shipped-policy guide on the training arena's stairs pit (start 22 of
+    benchmarks/guide_failures.py, evaluation seed 0): near pose 240 the guide drifts
+    to the right of its heading, and the left foot's target 0.7 s ahead lies on the
+    right sole; with no candidate left there, the plan stopped at pose 235. A step
+    toward the foot's place under the planning pose itself
+    (`GeneratorConfig.fallback_lookahead`) passes, and the whole guide is covered."""
+    from leas_jax.terrain import load_terrain
+
+    data = np.load(Path(__file__).parent / "data" / "arena_stairs_pit_drift_leas_guide.npz")
+    arena = load_terrain(Path(__file__).parents[1] / "terrains" / "training_arena.toml")
+    guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
+    plan = plan_contacts(arena, guide, timestep)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    no_fallback = plan_contacts(arena, guide, timestep, GeneratorConfig(fallback_lookahead=None))
+    assert no_fallback.last_valid_index == 235

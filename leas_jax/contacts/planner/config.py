@@ -18,6 +18,13 @@ class GeneratorConfig:
 
     stride: int = 5  # guide poses per planning pose, docs/design.md §6 ("every 5th pose by default")
     lookahead: float = 0.7  # s, where a moving foot should land on the guide, docs/design.md §6 (0.6-0.8 s)
+    # s, where a step aims when no foothold near the `lookahead` target gives a posture: the
+    # foot's place under the planning pose itself. A guide drifting sideways puts the
+    # lookahead target of the foot on the far side onto the other sole (then no candidate
+    # is left), and one turning or nearing an edge puts it where the leg cannot stand;
+    # the nearer target is what the foot needs to follow the root at all
+    # (test_a_step_falls_back_to_the_place_under_the_root). None: no fallback.
+    fallback_lookahead: float | None = 0.0
     mu: float = FRICTION  # friction coefficient, docs/design.md §6 checks 1 and 4
     # m, horizontal lag of a foot behind its nominal place that makes it step. Small enough
     # that on a slow climb (LeaS slows to ~0.06 m/s on eval_stairs, its root rising with each

@@ -76,12 +76,21 @@ class Walking:
         )
 
     def step(
-        self, guide, timestep, index: int, feet, side: int, min_gain: float | None = None
+        self,
+        guide,
+        timestep,
+        index: int,
+        feet,
+        side: int,
+        min_gain: float | None = None,
+        lookahead: float | None = None,
     ) -> tuple[list[ContactPosture] | None, bool]:
         """Move foot `side` at planning index `index`.
 
         min_gain: None, or the least cut of the foot's gap to its step target (`_step_gap`)
         a placement must bring, unless it brings the gap under 1.
+        lookahead: s; the step target is the foot's nominal place under the guide pose this
+        far ahead of the planning pose (None: `GeneratorConfig.lookahead`).
 
         Returns:
             ([single-support, double-support] postures, or None), and whether `min_gain`
@@ -115,14 +124,28 @@ class Walking:
             single = self.projection.posture(pose, index, [stance], air=(side, lifted), com_target=nearer)
         if single is None:
             return None, False
-        ahead = guide[min(index + int(round(cfg.lookahead / timestep)), len(guide) - 1)]
+        lookahead = cfg.lookahead if lookahead is None else lookahead
+        ahead = guide[min(index + int(round(lookahead / timestep)), len(guide) - 1)]
         target_pos, target_yaw = self.footholds.nominal_placement(ahead, side)
         target_pos = self.footholds.beam_lane(side, target_pos, target_yaw)
+        double, held_back = self._land(pose, index, feet, side, stance, target_pos, target_yaw, min_gain)
+        return (None if double is None else [single, double]), held_back
+
+    def _land(
+        self, pose, index: int, feet, side: int, stance, target_pos, target_yaw: float, min_gain
+    ) -> tuple[ContactPosture | None, bool]:
+        """The double-support posture of foot `side` landing near a step target (mutates
+        `feet` on success), and whether `min_gain` passed over a placement (see `step`).
+
+        pose: [4] planning pose; stance: (side, pos [3], rot [3, 3]) of the other sole;
+        target_pos: [3] world; target_yaw: rad."""
+        cfg = self.config
+        old_pos = feet[side][0]
         # Same candidates, in the same order, as `candidates(...)[:max_candidates]`, but
         # screened a few at a time: the first or second usually gives a posture, and
         # screening the whole pool at once costs a quarter of a plan's time.
         pool_pos, pool_rot = self.footholds.candidate_pool(
-            side, pose, target_pos, target_yaw, avoid=feet[other]
+            side, pose, target_pos, target_yaw, avoid=feet[1 - side]
         )
         needed = math.inf if min_gain is None else max(1.0, self._step_gap(old_pos, target_pos) - min_gain)
         tried, held_back = 0, False
@@ -142,25 +165,37 @@ class Walking:
                 double = self.projection.posture(pose, index, contacts)
                 if double is not None:
                     feet[side] = (pos, rot)
-                    return [single, double], held_back
+                    return double, held_back
         if tried == 0:
             self.projection.count_rejection("no foothold")
         return None, held_back
 
     def step_either(self, guide, timestep, index: int, feet, order) -> list[ContactPosture] | None:
         """Step one foot, trying the sides in `order`: first with `min_step_gain`, then, on
-        the sides where that test passed a placement over, without it. Postures or None."""
-        retry = []
-        for side in order:
-            stepped, held_back = self.step(guide, timestep, index, feet, side, self.config.min_step_gain)
-            if stepped is not None:
-                return stepped
-            if held_back:
-                retry.append(side)
-        for side in retry:
-            stepped, _ = self.step(guide, timestep, index, feet, side)
-            if stepped is not None:
-                return stepped
+        the sides where that test passed a placement over, without it; all of this toward
+        the `lookahead` target, then toward the `fallback_lookahead` one. Postures or None.
+
+        Both sides try the far target before either tries the near one: a short step of the
+        first side can leave the feet where the next planning poses fail, where the other
+        side's full step would not."""
+        cfg = self.config
+        lookaheads = [cfg.lookahead]
+        if cfg.fallback_lookahead is not None and cfg.fallback_lookahead != cfg.lookahead:
+            lookaheads.append(cfg.fallback_lookahead)
+        for lookahead in lookaheads:
+            retry = []
+            for side in order:
+                stepped, held_back = self.step(
+                    guide, timestep, index, feet, side, cfg.min_step_gain, lookahead
+                )
+                if stepped is not None:
+                    return stepped
+                if held_back:
+                    retry.append(side)
+            for side in retry:
+                stepped, _ = self.step(guide, timestep, index, feet, side, None, lookahead)
+                if stepped is not None:
+                    return stepped
         return None
 
     @staticmethod

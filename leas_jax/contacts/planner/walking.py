@@ -8,7 +8,9 @@ shifted over the stance sole; balanced on the stance foot alone), then a double-
 posture with the foot on a foothold near where it should be `lookahead` s ahead on the
 guide. The other foot is tried if the most lagging one cannot step; steps that bring
 their foot nearer its target (`min_step_gain`) are tried on both feet before a step that
-does not. At most `max_steps_per_pose` steps per planning pose (docs/design.md §6).
+does not; where neither foot can step toward its `lookahead` target, both try toward
+their places under the planning pose (`fallback_lookahead`). At most
+`max_steps_per_pose` steps per planning pose (docs/design.md §6).
 
 Host-only, not jittable.
 """

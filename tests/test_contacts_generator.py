@@ -429,19 +429,48 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
 
 
 def test_a_step_falls_back_to_the_place_under_the_root():
-    """A shipped-policy guide on the training arena's stairs pit (start 22 of
-    benchmarks/guide_failures.py, evaluation seed 0): near pose 240 the guide drifts
-    to the right of its heading, and the left foot's target 0.7 s ahead lies on the
-    right sole; with no candidate left there, the plan stopped at pose 235. A step
-    toward the foot's place under the planning pose itself
+    """The first 16 s of a shipped-policy guide on the training arena's stairs pit (start 236
+    of benchmarks/guide_failures.py, evaluation seed 0): at pose 120 the left foot lags
+    0.30 m behind its place and no foothold within `candidate_radius` of its place 0.7 s
+    ahead gives a posture, nor does the right foot's step; the plan stopped at pose 115.
+    A step toward the foot's place under the planning pose itself
     (`GeneratorConfig.fallback_lookahead`) passes, and the whole guide is covered."""
-    from leas_jax.terrain import load_terrain
-
-    data = np.load(Path(__file__).parent / "data" / "arena_stairs_pit_drift_leas_guide.npz")
-    arena = load_terrain(Path(__file__).parents[1] / "terrains" / "training_arena.toml")
+    data = np.load(Path(__file__).parent / "data" / "arena_stairs_pit_fallback_leas_guide.npz")
     guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
-    plan = plan_contacts(arena, guide, timestep)
+    plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    no_fallback = plan_contacts(arena, guide, timestep, GeneratorConfig(fallback_lookahead=None))
-    assert no_fallback.last_valid_index == 235
+    no_fallback = plan_contacts(_arena(), guide, timestep, GeneratorConfig(fallback_lookahead=None))
+    assert no_fallback.last_valid_index == 115
+
+
+def test_single_support_over_a_far_stance_sole():
+    """The first 24.5 s of a shipped-policy guide across the training arena's rubble (start
+    160, evaluation seed 0): at pose 205 each foot's single support needs the root more than
+    0.12 m off the guide to bring the CoM over the stance sole, which stands within its
+    comfort region but far from the guide root. Held to `max_root_offset_xy` (0.12 m) the plan stopped
+    at pose 200; with `max_single_support_offset_xy` the whole guide is covered, and `verify`
+    holds every single-support root to that bound."""
+    data = np.load(Path(__file__).parent / "data" / "arena_rubble_single_support_leas_guide.npz")
+    guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
+    plan = plan_contacts(_arena(), guide, timestep)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    in_air = ~np.all(np.isfinite(plan.feet[:, :, 0]), axis=1)
+    offsets = np.hypot(*(plan.q[:, :2] - guide[plan.guide_index, :2]).T)
+    assert offsets[~in_air].max() <= GeneratorConfig().max_root_offset_xy + 1e-6
+    assert 0.12 < offsets[in_air].max() <= GeneratorConfig().max_single_support_offset_xy + 1e-6
+    held = plan_contacts(_arena(), guide, timestep, GeneratorConfig(max_single_support_offset_xy=0.12))
+    assert held.last_valid_index == 200
+
+
+def _arena():
+    """The training arena (loaded once per test module)."""
+    from leas_jax.terrain import load_terrain
+
+    if "arena" not in _ARENA:
+        _ARENA["arena"] = load_terrain(Path(__file__).parents[1] / "terrains" / "training_arena.toml")
+    return _ARENA["arena"]
+
+
+_ARENA: dict = {}

@@ -260,3 +260,23 @@ def test_random_tampering_is_caught(plan):
         change = tamper(kind)
         report = verify(_with(base, **change))
         assert not report.ok, f"trial {trial}: {kind} tampering passed"
+
+
+def test_single_support_root_may_stand_farther_off_the_guide(plan):
+    """Check 0 holds a root within max_root_offset_xy (0.12 m) of its guide pose with both feet
+    down, within max_single_support_offset_xy (0.20 m) on one foot."""
+    from leas_jax.contacts import GeneratorConfig
+
+    config = GeneratorConfig()
+    one_foot = int(np.flatnonzero(~np.all(np.isfinite(plan.feet[:, :, 0]), axis=1))[0])
+    two_feet = _double_support(plan, one_foot + 1)
+
+    def root_off_guide(k, distance):
+        q = plan.q.copy()
+        q[k, :2] = plan.guide[plan.guide_index[k], :2] + np.array([0.0, distance])
+        return any("off guide pose" in m for m in _consistency_messages(verify(_with(plan, q=q))))
+
+    between = 0.5 * (config.max_root_offset_xy + config.max_single_support_offset_xy)
+    assert not root_off_guide(one_foot, between)
+    assert root_off_guide(two_feet, between)
+    assert root_off_guide(one_foot, config.max_single_support_offset_xy + 0.01)

@@ -11,7 +11,8 @@ Checks (numbering of docs/design.md §6; 0 is the plan's own consistency):
     0. arrays: finite q and guide, unit quaternions, feet rows all-finite or all-NaN, guide
        indices in range and non-decreasing, last_valid_index / coverage consistent with the
        guide; each posture's root where the generator puts it for its guide pose (yaw of
-       the pose, within max_root_offset_xy horizontally and max_root_offset_z below), and
+       the pose, within max_root_offset_xy horizontally, max_single_support_offset_xy on
+       one foot, and max_root_offset_z below), and
        its soles in contact within SOLE_TO_GUIDE_XY of that pose's root;
     1. each foot in contact lies flat on a support surface (sole rectangle 0.20 x 0.13 m
        inside a face whose normal is within the friction cone), within 5 mm and 3 deg;
@@ -260,12 +261,14 @@ def _guide_consistency(q_all, feet_all, guide, guide_index) -> list:
         index = int(guide_index[k])
         pose = guide[index]
         offset = float(np.hypot(*(q[:2] - pose[:2])))
+        one_foot = not np.all(np.isfinite(feet_all[k, :, 0]))
+        bound = config.max_single_support_offset_xy if one_foot else config.max_root_offset_xy
         drop = float(pose[2] - q[2])
         rot = matrix_from_quat_xyzw(q[3:7])
         yaw_error = abs((math.atan2(rot[1, 0], rot[0, 0]) - pose[3] + math.pi) % (2 * math.pi) - math.pi)
         tilt = float(np.hypot(rot[2, 0], rot[2, 1]))
         if (
-            offset > config.max_root_offset_xy + ROOT_TOL
+            offset > bound + ROOT_TOL
             or not -ROOT_TOL <= drop <= config.max_root_offset_z + ROOT_TOL
             or yaw_error > ROOT_TOL
             or tilt > ROOT_TOL
@@ -275,7 +278,7 @@ def _guide_consistency(q_all, feet_all, guide, guide_index) -> list:
                     k,
                     0,
                     f"root is {offset:.3f} m beside, {drop:.3f} m below and {math.degrees(yaw_error):.2f} deg "
-                    f"off guide pose {index} (the generator keeps it within {config.max_root_offset_xy} m, "
+                    f"off guide pose {index} (the generator keeps it within {bound} m, "
                     f"0 to {config.max_root_offset_z} m below, at the pose's yaw, level)",
                 )
             )

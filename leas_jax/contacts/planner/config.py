@@ -46,6 +46,15 @@ class GeneratorConfig:
     max_root_offset_xy: float = (
         0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
     )
+    # m, the same bound for a single-support posture, where the CoM must be over the stance
+    # sole. That sole may lie `max_foot_offset` (0.25 m) from its nominal place, itself 0.085 m
+    # beside the root: with max_root_offset_xy the generator accepted feet it could not then
+    # balance on (the most frequent reason its plans stopped on policy guides, 45 of 116 in
+    # docs/results/2026-12-02-arms-in). HPP's generator asks no balance of a one-contact
+    # state at all (hpp-rbprm ContactGenHelper, stableForOneContact = false by default); this
+    # one keeps it, quasi-static, with the root shifted this far
+    # (test_single_support_over_a_far_stance_sole).
+    max_single_support_offset_xy: float = 0.20
     max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
     min_knee: float = (
         0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)

@@ -3,7 +3,8 @@
 The stage every other stage of the generator calls (HPP's "projection" of a state onto
 its contacts): the root follows the guide (yaw and height from it, lowered by at most
 `max_root_offset_z` if a leg would be overstretched, shifted horizontally by at most
-`max_root_offset_xy` to bring the CoM over the support), the legs reach their soles by
+`max_root_offset_xy`, or `max_single_support_offset_xy` on one foot, to bring the CoM
+over the support), the legs reach their soles by
 analytic IK within the joint limits, the upper body holds the first of
 `GeneratorConfig.upper_bodies` whose arms miss the terrain, and the posture must be free
 of terrain and self collision (coal) and in static equilibrium (hpp-centroidal-dynamics
@@ -168,10 +169,11 @@ class PostureProjection:
         talos = self.talos
         iterations = 1 if offset is not None else 3
         shift = np.zeros(2) if offset is None else offset
+        bound = cfg.max_root_offset_xy if air is None else cfg.max_single_support_offset_xy
         for it in range(iterations):
             norm = float(np.hypot(*shift))
-            if norm > cfg.max_root_offset_xy:
-                shift = shift * (cfg.max_root_offset_xy / norm)
+            if norm > bound:
+                shift = shift * (bound / norm)
             root_xy = guide_xy + shift
             z = self.root_height(guide_pose, root_xy, root_R, contacts)
             if z is None:

@@ -345,9 +345,9 @@ def test_the_foot_that_can_lead_steps_first_beside_a_void():
     plan = plan_contacts(bridge, data["guide"], float(data["timestep"]))
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    any_step = plan_contacts(
-        bridge, data["guide"], float(data["timestep"]), GeneratorConfig(min_step_gain=None)
-    )
+    # Without it (and without the later step fallback and single-support root bound, which
+    # get past this place by other steps) the plan stops there.
+    any_step = plan_contacts(bridge, data["guide"], float(data["timestep"]), _earlier(min_step_gain=None))
     assert any_step.last_valid_index == 230 and data["guide"][230, 0] < 4.0
 
 
@@ -357,7 +357,7 @@ def test_soles_turn_to_a_narrow_bridge_axis():
     beam's axis fit; with the turning disabled this plan stops on the bridge. (At 0.2 rad
     staggered soles at the guide's yaw cross too, once a sole may rest across the
     platform's and the bridge's coplanar tops; at 0.3 rad they cross too with the step
-    fallback to the place under the root, `fallback_lookahead`, so it is off here.)"""
+    fallback and the single-support root bound, so those are off here: `_earlier`.)"""
     bridge = loads_terrain(
         HEAD
         + box([0.5, 0, -0.1], [3, 4, 0.2])
@@ -375,7 +375,7 @@ def test_soles_turn_to_a_narrow_bridge_axis():
         2 * (on_bridge[:, 6] * on_bridge[:, 5]), 1 - 2 * on_bridge[:, 5] ** 2
     )  # quaternion xyzw
     assert len(on_bridge) >= 4 and np.abs(yaws).max() < 1e-6
-    stiff = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0, fallback_lookahead=None))
+    stiff = plan_contacts(bridge, guide, DT, _earlier(beam_align_yaw=0.0))
     assert stiff.coverage < 1.0
     assert 2.0 < x_at(stiff, stiff.last_valid_index) < 4.0
 
@@ -462,6 +462,12 @@ def test_single_support_over_a_far_stance_sole():
     assert 0.12 < offsets[in_air].max() <= GeneratorConfig().max_single_support_offset_xy + 1e-6
     held = plan_contacts(_arena(), guide, timestep, GeneratorConfig(max_single_support_offset_xy=0.12))
     assert held.last_valid_index == 200
+
+
+def _earlier(**changes) -> GeneratorConfig:
+    """The generator before its step fallback and single-support root bound, with `changes`:
+    for tests that show what an earlier feature was needed for."""
+    return GeneratorConfig(fallback_lookahead=None, max_single_support_offset_xy=0.12, **changes)
 
 
 def _arena():

@@ -465,3 +465,22 @@ def _arena():
 
 
 _ARENA: dict = {}
+
+
+def test_candidates_keep_the_foot_out_of_a_riser_behind_the_heel():
+    """A step down at x = 1.0 (0.15 m). A left sole on the lower tread with its rectangle's
+    back edge 6 mm from the riser fits its face (5 mm margin), but the foot's collision
+    geometry overhangs the heel by 1.6 cm and would meet the riser: `screen` drops it, and
+    keeps the same sole 3 cm farther on."""
+    from leas_jax.contacts.planner.generator import LEFT
+    from leas_jax.contacts.robot.collision import foot_footprint, robot_collision
+
+    terrain = loads_terrain(HEAD + box([0.0, 0, 0.0], [2.0, 4, 0.3]) + box([3.0, 0, -0.1], [4.0, 4, 0.2]))
+    generator = ContactGenerator(terrain)
+    heel = -float(foot_footprint(robot_collision(generator.talos), LEFT)[:, 0].min())
+    assert 0.11 < heel < 0.12  # the sole's half length is 0.10 m
+    xs = np.array([1.106, 1.136])
+    pos = np.stack([xs, np.full(2, 0.1), np.zeros(2)], axis=1)
+    rot = np.repeat(np.eye(3)[None], 2, axis=0)
+    pose = np.array([1.12, 0.0, H, 0.0])
+    assert generator.footholds.screen(LEFT, pose, pos, rot).tolist() == [False, True]

@@ -24,8 +24,9 @@ from leas_jax.contacts.planner.surfaces import (
     sole_rotation_single,
     uncovered,
 )
+from leas_jax.contacts.robot.collision import foot_footprint, robot_collision
 from leas_jax.contacts.robot.ik import leg_ik
-from leas_jax.contacts.robot.model import LEFT, SOLE_LENGTH, SOLE_WIDTH
+from leas_jax.contacts.robot.model import LEFT, RIGHT, SOLE_LENGTH, SOLE_WIDTH
 
 SCREEN_CHUNK = 6  # pool candidates screened at once (the cost is mostly per call)
 
@@ -54,6 +55,8 @@ class Footholds:
         self.databases = databases
         self.config = config
         self._nominal = talos.nominal_sole_in_root  # [2, 3] root frame
+        robot = robot_collision(talos)
+        self._footprint = [foot_footprint(robot, side) for side in (LEFT, RIGHT)]  # [4, 3] sole frame
         self._beams = {}  # face index -> [A, 3] beam edges (`beam_edges`)
 
     def nominal_placement(self, guide_pose, side: int) -> tuple[np.ndarray, float]:
@@ -188,16 +191,21 @@ class Footholds:
 
     def screen(self, side: int, guide_pose, pos, rot) -> np.ndarray:
         """[N] the cover and reach tests of `candidates` on placements pos [N, 3], rot [N, 3, 3]:
-        nothing of the terrain over the sole, and reachable within the joint limits from
-        the guide root or the lowest allowed root. Each entry depends on its row only."""
+        nothing of the terrain over the sole or the foot's footprint
+        (`collision.foot_footprint`), and reachable within the joint limits from the guide
+        root or the lowest allowed root. Each entry depends on its row only."""
         cfg = self.config
         if len(pos) == 0:
             return np.zeros(0, dtype=bool)
         root_R = rotz(guide_pose[3])
         root_p = np.asarray(guide_pose[:3], dtype=np.float64)
-        corners = sole_corners_world(pos, rot)
-        probe = np.concatenate([corners, pos[:, None, :]], axis=1).reshape(-1, 3)
-        free = np.all(uncovered(self.terrain, probe, cfg.cover_tol).reshape(-1, 5), axis=1)
+        # The sole's corners and centre, and the corners of the foot's footprint, which
+        # overhangs the sole: nothing of the terrain may rise over any of them.
+        footprint = pos[:, None, :] + np.einsum("nij,cj->nci", rot, self._footprint[side])
+        probe = np.concatenate([sole_corners_world(pos, rot), pos[:, None, :], footprint], axis=1)
+        free = np.all(
+            uncovered(self.terrain, probe.reshape(-1, 3), cfg.cover_tol).reshape(len(pos), -1), axis=1
+        )
         pos, rot = pos[free], rot[free]
         leg = self.talos.legs[side]
         local_rot = np.einsum("ji,njk->nik", root_R, rot)

@@ -396,6 +396,27 @@ def _legs_joint_frames(
     return frames
 
 
+def foot_footprint(robot: RobotCollision, side: int) -> np.ndarray:
+    """[4, 3] corners of the horizontal bounds of a foot's collision geometry (the ankle-roll
+    link's, link 6), in its sole frame (z = 0).
+
+    The foot's mesh overhangs the 0.20 x 0.13 m sole rectangle (by 1.6 cm at the heel), so a
+    sole that fits its face can still put the foot into a riser beside it. The sole frame
+    lies straight below the link's frame (Talos's sole joint: 0, 0, -0.107 m), so the
+    link frame's x and y bounds are the sole frame's.
+
+    Args:
+        robot: the robot's collision geometries.
+        side: 0 left, 1 right.
+    """
+    (geometry,) = np.flatnonzero((robot.leg_of == side) & (robot.leg_link == 6))
+    lo = robot.local_center[geometry, :2] - robot.local_half[geometry, :2]
+    hi = robot.local_center[geometry, :2] + robot.local_half[geometry, :2]
+    return np.array(
+        [[x, y, 0.0] for x, y in ((hi[0], hi[1]), (lo[0], hi[1]), (lo[0], lo[1]), (hi[0], lo[1]))]
+    )
+
+
 _ROBOT_CACHE: dict = {}
 
 

@@ -1,6 +1,7 @@
 #!/bin/sh
-# The contact generator's step fallback (GeneratorConfig.fallback_lookahead) and its
-# single-support root bound (max_single_support_offset_xy): the policies' own arena guides,
+# The contact generator's step fallback (GeneratorConfig.fallback_lookahead), its
+# single-support root bound (max_single_support_offset_xy) and its candidates screened over
+# the foot's footprint (collision.foot_footprint): the policies' own arena guides,
 # the pillar check, the scenarios and Table II, each against the generator without them
 # (docs/results/2026-12-02-arms-in). Run from the repository root with the environment
 # installed (`make venv`); 2 cores.
@@ -16,6 +17,11 @@ for PAIR in shipped:checkpoints/leas_talos pretrain:checkpoints/leas_talos/pretr
   PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
     --spawns condition --out $D/guides/${PAIR%%:*}
 done
+# 1b. The shipped policy from generator-verified resets (the spawn verdicts are cached by
+#     the generator's settings and code: 59 286 poses labelled again, about 10 min, once).
+PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
+  --workers 2 --spawns generator --out $D/guides/shipped_verified_spawns
+
 # 2. The pillar check (15 s per policy).
 for P in checkpoints/leas_talos checkpoints/leas_talos/pretrain \
     docs/results/2026-12-01-learned-paper/train_paper_learned; do

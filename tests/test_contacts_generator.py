@@ -420,7 +420,7 @@ def test_a_step_falls_back_to_the_place_under_the_root():
     ahead gives a posture, nor does the right foot's step; the plan stopped at pose 115.
     A step toward the foot's place under the planning pose itself
     (`GeneratorConfig.fallback_lookahead`) passes, and the whole guide is covered."""
-    data = np.load(Path(__file__).parent / "data" / "arena_stairs_pit_fallback_leas_guide.npz")
+    data = np.load(Path(__file__).parent / "data" / "training_arena_stairs_pit_fallback_leas_guide.npz")
     guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
@@ -436,7 +436,7 @@ def test_single_support_over_a_far_stance_sole():
     comfort region but far from the guide root. Held to `max_root_offset_xy` (0.12 m) the plan stopped
     at pose 200; with `max_single_support_offset_xy` the whole guide is covered, and `verify`
     holds every single-support root to that bound."""
-    data = np.load(Path(__file__).parent / "data" / "arena_rubble_single_support_leas_guide.npz")
+    data = np.load(Path(__file__).parent / "data" / "training_arena_rubble_single_support_leas_guide.npz")
     guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0

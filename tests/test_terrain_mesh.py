@@ -91,7 +91,7 @@ def test_round_trip_contact_plans(guide, tmp_path):
 
     with np.load(guide) as data:
         path, dt = data["guide"], float(data["timestep"])
-    # eval_<scenario>_<what>_leas_guide.npz is a path on terrains/eval_<scenario>.toml
+    # <a>_<b>_<what>_leas_guide.npz is a path on terrains/<a>_<b>.toml (eval_stairs, training_arena)
     boxes = load_terrain(REPO / "terrains" / ("_".join(guide.stem.split("_")[:2]) + ".toml"))
     mesh = _twin(boxes, tmp_path)
     a, b = plan_contacts(boxes, path, dt), plan_contacts(mesh, path, dt)

@@ -84,15 +84,15 @@ class Walking:
         index: int,
         feet,
         side: int,
-        min_gain: float | None = None,
-        lookahead: float | None = None,
+        min_gain: float | None,
+        lookahead: float,
     ) -> tuple[list[ContactPosture] | None, bool]:
         """Move foot `side` at planning index `index`.
 
         min_gain: None, or the least cut of the foot's gap to its step target (`_step_gap`)
         a placement must bring, unless it brings the gap under 1.
         lookahead: s; the step target is the foot's nominal place under the guide pose this
-        far ahead of the planning pose (None: `GeneratorConfig.lookahead`).
+        far ahead of the planning pose.
 
         Returns:
             ([single-support, double-support] postures, or None), and whether `min_gain`
@@ -126,7 +126,6 @@ class Walking:
             single = self.projection.posture(pose, index, [stance], air=(side, lifted), com_target=nearer)
         if single is None:
             return None, False
-        lookahead = cfg.lookahead if lookahead is None else lookahead
         ahead = guide[min(index + int(round(lookahead / timestep)), len(guide) - 1)]
         target_pos, target_yaw = self.footholds.nominal_placement(ahead, side)
         target_pos = self.footholds.beam_lane(side, target_pos, target_yaw)

@@ -1,15 +1,19 @@
 """Ablation study of issue 19: does the learned condition, the planner in the loop, or both, make
 guides the contact generator can follow?
 
-Four methods, each trained from scratch with every seed of `--seeds` at equal env steps:
+Four methods, each trained from scratch with every seed of `--seeds`:
 
-* `cylinders`: geometric PPO with the paper's cylinders (the presets' TRAINING_REACHABILITY),
-  `--geometric-steps + --planner-steps` steps;
-* `cylinders+planner`: `--geometric-steps` geometric steps, then `--planner-steps` kept steps of
-  planner-in-the-loop PPO (the paper's pruning);
-* `learned`: geometric PPO terminating on the learned condition (`--weights`), all the steps;
-* `learned+planner`: as `cylinders+planner` with the learned condition, refreshed on the
-  generator's verdicts during the planner phase (DAgger, `--refresh-every`).
+* `cylinders`: geometric PPO with the paper's cylinders (the preset's env), `--geometric-steps`;
+* `cylinders+planner`: that same geometric run (same seed), then `--planner-steps` kept steps
+  of planner-in-the-loop PPO (the preset's planner phase, the paper's pruning);
+* `learned`: geometric PPO terminating on the learned condition (`--weights`), `--geometric-steps`;
+* `learned+planner`: as `cylinders+planner` from the `learned` run, the condition refreshed on
+  the generator's verdicts during the planner phase (DAgger, `--refresh-every`).
+
+A planner phase continues its method's own geometric run, so each seed's pair differs only by
+the planner phase (a paired comparison); it adds `--planner-steps` env steps to the geometric
+budget (150 k against 80 M for `quick`: 0.2 %), so the methods train at equal env steps to
+within that.
 
 Per policy (deterministic): on the training arena, from the env's own random resets
 (`--starts` per evaluation seed, `--eval-seeds`), the fraction of its guides the contact
@@ -71,31 +75,30 @@ def bootstrap_interval(
 
 
 def method_configs(method: str, seed: int, args):
-    """(geometric TrainConfig, planner TrainConfig or None) of one method and seed."""
+    """(geometric TrainConfig, planner TrainConfig or None) of one method and seed; the
+    geometric config is the same for `X` and `X+planner`."""
     from leas_jax.training.config import PRESETS, TRAINING_ENV, learned_condition_env, preset
 
     env = PRESETS[args.preset].get("env", TRAINING_ENV)  # the preset's env: `quick` adds the clearance term
     if method.startswith("learned"):
         env = learned_condition_env(env, args.weights)
     env = dataclasses.replace(env, episode_length=args.episode_length)
-    planner = method.endswith("+planner")
-    geometric_steps = args.geometric_steps + (0 if planner else args.planner_steps)
     geo = preset(
         args.preset,
-        num_timesteps=geometric_steps,
+        num_timesteps=args.geometric_steps,
         seed=seed,
         env=env,
         **({"num_envs": args.num_envs, "num_minibatches": 4} if args.num_envs else {}),
     )
-    if not planner:
+    if not method.endswith("+planner"):
         return geo, None
     plan = preset(
-        "smoke",
+        _planner_preset(args.preset),
         mode="planner",
+        pretrain="",
         num_timesteps=args.planner_steps,
         num_envs=args.planner_envs,
         num_minibatches=4 if args.planner_envs % 4 == 0 else 1,
-        num_epochs=4,
         seed=seed,
         env=env,
         condition_refresh_every=args.refresh_every if method == "learned+planner" else 0,
@@ -104,18 +107,28 @@ def method_configs(method: str, seed: int, args):
     return geo, plan
 
 
+def _planner_preset(geometric: str) -> str:
+    """The planner-mode preset that continues geometric preset `geometric` (its namesake, else `smoke`)."""
+    from leas_jax.training.config import PLANNER_PRESETS
+
+    return geometric if geometric in PLANNER_PRESETS else "smoke"
+
+
 def train_method(method: str, seed: int, args, out: Path) -> Path:
-    """Train one method and seed (a finished run is resumed to its end, i.e. reused); its run directory."""
+    """Train one method and seed (a finished run is resumed to its end, i.e. reused); its run
+    directory. `X+planner` continues `X`'s geometric run of the same seed."""
     from leas_jax.training import train
 
     geo, plan = method_configs(method, seed, args)
-    run = out / "runs" / method.replace("+", "_") / f"seed{seed}"
-    train(geo, run / "geometric", progress=False)
+    base = method.split("+")[0]
+    geometric = out / "runs" / base / f"seed{seed}" / "geometric"
+    train(geo, geometric, progress=False)
     if plan is None:
-        return run / "geometric"
-    plan = dataclasses.replace(plan, init_from=str(run / "geometric"))
-    train(plan, run / "planner", progress=False, workers=args.workers)
-    return run / "planner"
+        return geometric
+    plan = dataclasses.replace(plan, init_from=str(geometric))
+    run = out / "runs" / method.replace("+", "_") / f"seed{seed}" / "planner"
+    train(plan, run, progress=False, workers=args.workers)
+    return run
 
 
 def evaluate_policy(run_dir: Path, args) -> dict:
@@ -247,7 +260,7 @@ def markdown(report: dict) -> str:
         "# Feasibility ablation",
         "",
         f"{len(s.get('seeds_done', s['seeds']))} training seeds ({', '.join(map(str, s.get('seeds_done', s['seeds'])))}), {s['geometric_steps']} geometric + {s['planner_steps']} planner env steps "
-        f"(the geometric-only methods train all of them geometrically); {s['starts']} arena starts x "
+        f"(a planner phase continues its method's geometric run of the same seed); {s['starts']} arena starts x "
         f"{len(s['eval_seeds'])} evaluation seeds, {s['episode_length']}-step episodes. Mean [95 % interval "
         "across seeds and starts].",
         "",
@@ -302,6 +315,7 @@ def main(argv=None) -> dict:
     from common import machine
 
     from leas_jax.errors import UsageError
+    from leas_jax.training.config import PLANNER_PRESETS, PRESETS
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True)
@@ -311,8 +325,10 @@ def main(argv=None) -> dict:
         "--preset", default="quick", help="geometric preset (its PPO settings; steps and env are set here)"
     )
     parser.add_argument("--num-envs", type=int, default=0, help="geometric envs (0: the preset's)")
-    parser.add_argument("--geometric-steps", type=int, default=20_000_000)
-    parser.add_argument("--planner-steps", type=int, default=50_000, help="kept planner-in-the-loop steps")
+    parser.add_argument("--geometric-steps", type=int, default=0, help="geometric env steps (0: the preset's)")
+    parser.add_argument(
+        "--planner-steps", type=int, default=0, help="kept planner-in-the-loop steps (0: the planner preset's)"
+    )
     parser.add_argument("--planner-envs", type=int, default=64, help="guides validated per planner iteration")
     parser.add_argument(
         "--refresh-every", type=int, default=4, help="learned+planner: DAgger refresh period (iterations)"
@@ -347,9 +363,14 @@ def main(argv=None) -> dict:
         raise UsageError(f"--methods: unknown {', '.join(unknown)}; choose among {', '.join(METHODS)}")
     args.seeds = _parse_ints("seeds", args.seeds)
     args.eval_seeds = _parse_ints("eval-seeds", args.eval_seeds)
+    if args.preset not in PRESETS:
+        raise UsageError(f"--preset: unknown {args.preset!r}; choose among {', '.join(PRESETS)}")
+    for name in ("geometric_steps", "planner_steps"):
+        if getattr(args, name) < 0:
+            raise UsageError(f"--{name.replace('_', '-')} must be >= 0 (0: the preset's)")
+    args.geometric_steps = args.geometric_steps or PRESETS[args.preset]["num_timesteps"]
+    args.planner_steps = args.planner_steps or PLANNER_PRESETS[_planner_preset(args.preset)]["num_timesteps"]
     for name in (
-        "geometric_steps",
-        "planner_steps",
         "planner_envs",
         "starts",
         "ground_starts",

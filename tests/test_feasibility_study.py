@@ -65,6 +65,8 @@ def test_bad_arguments_name_the_option(tmp_path):
         fs.main(["--out", str(tmp_path), "--methods", "cylinders,boxes"])
     with pytest.raises(UsageError, match="--seeds"):
         fs.main(["--out", str(tmp_path), "--seeds", "a"])
+    with pytest.raises(UsageError, match="--preset"):
+        fs.main(["--out", str(tmp_path), "--preset", "huge"])
 
 
 TINY = [
@@ -107,4 +109,10 @@ def test_study_runs_end_to_end_on_tiny_settings(tmp_path):
             entry = saved["summary"][method][metric]
             assert entry["lo"] <= entry["mean"] <= entry["hi"], (method, metric)
     assert (tmp_path / "feasibility_study.png").is_file() and (tmp_path / "feasibility_study.md").is_file()
-    assert (tmp_path / "runs" / "learned_planner" / "seed0" / "planner" / "condition_data.npz").is_file()
+    runs = tmp_path / "runs"
+    assert (runs / "learned_planner" / "seed0" / "planner" / "condition_data.npz").is_file()
+    # a planner phase continues its method's own geometric run: no second geometric run
+    assert not (runs / "cylinders_planner" / "seed0" / "geometric").exists()
+    assert not (runs / "learned_planner" / "seed0" / "geometric").exists()
+    planner = json.loads((runs / "cylinders_planner" / "seed0" / "planner" / "config.json").read_text())
+    assert Path(planner["init_from"]) == runs / "cylinders" / "seed0" / "geometric"

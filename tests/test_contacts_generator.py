@@ -484,3 +484,21 @@ def test_candidates_keep_the_foot_out_of_a_riser_behind_the_heel():
     rot = np.repeat(np.eye(3)[None], 2, axis=0)
     pose = np.array([1.12, 0.0, H, 0.0])
     assert generator.footholds.screen(LEFT, pose, pos, rot).tolist() == [False, True]
+
+
+def test_first_stance_steps_away_from_a_box_beside_a_shin():
+    """A 0.09 m box 4 cm beside the right sole's nominal place: the shin's ankle linkage
+    (4 cm above the sole, out past its side) meets it at the nominal stance and at every
+    candidate near it, so without `stance_shifts` the plan has no first posture; with them
+    both soles' places move a few cm away, the root follows, and the plan verifies."""
+    ground = box([3, 0, -0.1], [8, 4, 0.2])
+    # nominal soles at y = +-0.085, 0.14 m wide: the right one's outer edge at y = -0.155
+    beside = box([0.0, -0.295, 0.045], [0.6, 0.2, 0.09])
+    terrain = loads_terrain(HEAD + ground + beside)
+    guide = straight(0.0, 1.5)
+    plan = plan_contacts(terrain, guide, DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    assert plan_contacts(terrain, guide, DT, GeneratorConfig(stance_shifts=())).last_valid_index < 0
+    with pytest.raises(ValueError, match="stance_shifts"):
+        GeneratorConfig(stance_shifts=(0.5,))

@@ -55,6 +55,15 @@ class GeneratorConfig:
     # one keeps it, quasi-static, with the root shifted this far
     # (test_single_support_over_a_far_stance_sole).
     max_single_support_offset_xy: float = 0.20
+    # m, where no stance under the guide's first pose passes every check, both soles' targets
+    # are moved together this far in each of 8 root-frame directions (nearest first; the
+    # first candidate of each foot), the root following within `max_root_offset_xy`. Beside a
+    # 0.1 m box the shin's ankle linkage, 4 cm above the sole and out past its side, meets
+    # the box at the nominal stance and at every candidate near it: 17 of the shipped policy's
+    # 256 arena guides stopped at their first pose, 16 of them so
+    # (docs/results/2026-12-02-step-fallback; test_first_stance_steps_away_from_a_box_beside_a_shin).
+    # () tries the nominal stance only.
+    stance_shifts: tuple = (0.05, 0.10)
     max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
     min_knee: float = (
         0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
@@ -114,4 +123,9 @@ class GeneratorConfig:
             raise ValueError(
                 f"GeneratorConfig.upper_bodies must name one or more of {sorted(UPPER_BODY_POSTURES)}, "
                 f"got {self.upper_bodies!r}"
+            )
+        if not all(isinstance(d, (int, float)) and 0.0 < d <= self.max_root_offset_xy for d in self.stance_shifts):
+            raise ValueError(
+                "GeneratorConfig.stance_shifts must be distances in (0, max_root_offset_xy = "
+                f"{self.max_root_offset_xy}] m, got {self.stance_shifts!r}"
             )

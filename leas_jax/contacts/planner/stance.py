@@ -2,21 +2,78 @@
 
 The first stage of the generator: both soles at their half-sitting places under guide
 pose 0, moved onto support surfaces (`footholds`), in one double-support posture that
-passes every check (`projection`); docs/design.md §6. Not jittable.
+passes every check (`projection`); where none does, the same with both soles' places moved
+together a few cm (`GeneratorConfig.stance_shifts`); docs/design.md §6. Not jittable.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from leas_jax.contacts.planner.config import GeneratorConfig
 from leas_jax.contacts.planner.footholds import Footholds
-from leas_jax.contacts.planner.projection import ContactPosture, PostureProjection
+from leas_jax.contacts.planner.projection import ContactPosture, PostureProjection, rotz
 from leas_jax.contacts.robot.model import LEFT, RIGHT
 
 
 def initial_stance(
     pose, footholds: Footholds, projection: PostureProjection, config: GeneratorConfig
 ) -> tuple[list, ContactPosture] | None:
-    """Initial stance at a guide's first pose: feet at their nominal places moved onto faces.
+    """Initial stance at a guide's first pose: `nominal_stance`, else `shifted_stance`.
+
+    Args:
+        pose: [4] root pose (x, y, z, yaw), world frame, z = base_link height.
+        footholds, projection: the terrain's stages.
+        config: generator settings.
+
+    Returns:
+        ([left, right] sole placements (pos [3], rot [3, 3]), the posture at `pose`), or None
+        where the generator cannot stand there.
+    """
+    found = nominal_stance(pose, footholds, projection, config)
+    return found if found is not None else shifted_stance(pose, footholds, projection, config)
+
+
+def stance_shifts(distances) -> np.ndarray:
+    """[8 x len(distances), 2] root-frame (forward, left) offsets of the soles' places: 8
+    directions (45 degrees apart) at each distance, nearest first."""
+    angles = np.arange(8) * (np.pi / 4)
+    return np.array([(d * np.cos(a), d * np.sin(a)) for d in sorted(distances) for a in angles]).reshape(-1, 2)
+
+
+def shifted_stance(
+    pose, footholds: Footholds, projection: PostureProjection, config: GeneratorConfig
+) -> tuple[list, ContactPosture] | None:
+    """The first stance, in `stance_shifts(config.stance_shifts)` order, with both soles'
+    targets moved by that root-frame offset (the first candidate of each foot) whose posture
+    at `pose` passes every check; the root shifts toward the soles within
+    `max_root_offset_xy` as in any double-support posture. None if none does.
+
+    Args and returns: as `initial_stance`.
+    """
+    pose = np.asarray(pose, dtype=np.float64)
+    root_R = rotz(pose[3])
+    for offset in stance_shifts(config.stance_shifts):
+        shift = root_R[:2, :2] @ offset
+        moved = np.array([pose[0] + shift[0], pose[1] + shift[1], pose[2], pose[3]])
+        left_target, left_yaw = footholds.nominal_placement(moved, LEFT)
+        right_target, right_yaw = footholds.nominal_placement(moved, RIGHT)
+        left = footholds.first_candidate(LEFT, moved, left_target, left_yaw)
+        if left is None:
+            continue
+        right = footholds.first_candidate(RIGHT, moved, right_target, right_yaw, left)
+        if right is None:
+            continue
+        posture = projection.posture(pose, 0, [(LEFT, *left), (RIGHT, *right)])
+        if posture is not None:
+            return [left, right], posture
+    return None
+
+
+def nominal_stance(
+    pose, footholds: Footholds, projection: PostureProjection, config: GeneratorConfig
+) -> tuple[list, ContactPosture] | None:
+    """Initial stance with the feet at their nominal places under `pose` moved onto faces.
 
     The best candidate of each foot first (the right one's avoids the left one); if
     that stance fails a check (a sole across a rubble tile's edge tilts the legs

@@ -325,9 +325,14 @@ def main(argv=None) -> dict:
         "--preset", default="quick", help="geometric preset (its PPO settings; steps and env are set here)"
     )
     parser.add_argument("--num-envs", type=int, default=0, help="geometric envs (0: the preset's)")
-    parser.add_argument("--geometric-steps", type=int, default=0, help="geometric env steps (0: the preset's)")
     parser.add_argument(
-        "--planner-steps", type=int, default=0, help="kept planner-in-the-loop steps (0: the planner preset's)"
+        "--geometric-steps", type=int, default=0, help="geometric env steps (0: the preset's)"
+    )
+    parser.add_argument(
+        "--planner-steps",
+        type=int,
+        default=0,
+        help="kept planner-in-the-loop steps (0: the planner preset's)",
     )
     parser.add_argument("--planner-envs", type=int, default=64, help="guides validated per planner iteration")
     parser.add_argument(

@@ -214,7 +214,12 @@ def test_single_support_with_a_shorter_root_shift_passes_a_pillar():
     terrain = loads_terrain(HEAD + box([3, 0, -0.1], [8, 4, 0.2]) + box([2.0, 0.76, 0.7], [0.3, 0.3, 1.6]))
     guide = straight(0.0, 4.0)
     centred = plan_contacts(
-        terrain, guide, DT, GeneratorConfig(single_support_com_inset=None, upper_bodies=("half_sitting",))
+        terrain,
+        guide,
+        DT,
+        GeneratorConfig(
+            single_support_com_inset=None, upper_bodies=("half_sitting",), arm_clearance_shifts=()
+        ),
     )
     assert centred.coverage < 0.6
     plan = plan_contacts(terrain, guide, DT)
@@ -227,9 +232,8 @@ def test_arms_held_in_pass_a_pillar_beside_the_path():
     meets it and the rigid upper body stops; the arms held in (0.38 m) pass, only there."""
     terrain = loads_terrain(HEAD + box([3, 0, -0.1], [8, 4, 0.2]) + box([2.0, 0.63, 0.7], [0.3, 0.3, 1.6]))
     guide = straight(0.0, 4.0)
-    rigid, why = ContactGenerator(terrain, GeneratorConfig(upper_bodies=("half_sitting",))).stop_reasons(
-        guide, DT
-    )
+    paper = GeneratorConfig(upper_bodies=("half_sitting",), arm_clearance_shifts=())
+    rigid, why = ContactGenerator(terrain, paper).stop_reasons(guide, DT)
     assert rigid.coverage < 0.5
     assert 1.2 < x_at(rigid, rigid.last_valid_index) < 1.85
     assert why.most_common(1)[0][0] == "terrain collision: arm"
@@ -502,3 +506,22 @@ def test_first_stance_steps_away_from_a_box_beside_a_shin():
     assert plan_contacts(terrain, guide, DT, GeneratorConfig(stance_shifts=())).last_valid_index < 0
     with pytest.raises(ValueError, match="stance_shifts"):
         GeneratorConfig(stance_shifts=(0.5,))
+
+
+def test_root_steps_sideways_off_a_pillar_the_arms_meet():
+    """The first 3 s of a shipped-policy guide starting beside one of the training arena's
+    pillars (start 12 of benchmarks/guide_failures.py, evaluation seed 0): the policy turns
+    on the spot with the pillar's face inside the reach of the shoulders (0.38 m to the side
+    of the root even with the arms held in), so every posture from pose 10 on met it and the
+    plan stopped at pose 5. With the root shifted sideways off the guide
+    (`GeneratorConfig.arm_clearance_shifts`, within the usual root bounds) the whole guide is
+    covered and verified."""
+    data = np.load(Path(__file__).parent / "data" / "training_arena_pillars_arm_clearance_leas_guide.npz")
+    guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
+    plan = plan_contacts(_arena(), guide, timestep)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    held = plan_contacts(_arena(), guide, timestep, GeneratorConfig(arm_clearance_shifts=()))
+    assert held.last_valid_index == 5
+    with pytest.raises(ValueError, match="arm_clearance_shifts"):
+        GeneratorConfig(arm_clearance_shifts=(0.0,))

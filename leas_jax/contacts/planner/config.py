@@ -64,6 +64,12 @@ class GeneratorConfig:
     # (docs/results/2026-12-02-step-fallback; test_first_stance_steps_away_from_a_box_beside_a_shin).
     # () tries the nominal stance only.
     stance_shifts: tuple = (0.05, 0.10)
+    # m, where an arm or gripper meets the terrain in every upper body (`upper_bodies`, the
+    # last with its shoulders 0.38 m to the side), the root shifted this far sideways off the
+    # guide, either side (nearest first; the usual root bounds hold). The training condition's
+    # trunk cylinder lets a guide pass a pillar or wall 0.30 m from the root
+    # (test_root_steps_sideways_off_a_pillar_the_arms_meet). () never.
+    arm_clearance_shifts: tuple = (0.06, 0.12)
     max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
     min_knee: float = (
         0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
@@ -124,8 +130,18 @@ class GeneratorConfig:
                 f"GeneratorConfig.upper_bodies must name one or more of {sorted(UPPER_BODY_POSTURES)}, "
                 f"got {self.upper_bodies!r}"
             )
-        if not all(isinstance(d, (int, float)) and 0.0 < d <= self.max_root_offset_xy for d in self.stance_shifts):
-            raise ValueError(
-                "GeneratorConfig.stance_shifts must be distances in (0, max_root_offset_xy = "
-                f"{self.max_root_offset_xy}] m, got {self.stance_shifts!r}"
-            )
+        _check_distances("stance_shifts", self.stance_shifts, "max_root_offset_xy", self.max_root_offset_xy)
+        _check_distances(
+            "arm_clearance_shifts",
+            self.arm_clearance_shifts,
+            "max_single_support_offset_xy",
+            self.max_single_support_offset_xy,
+        )
+
+
+def _check_distances(name: str, values, bound_name: str, bound: float) -> None:
+    """Raise ValueError unless every one of `values` is a distance in (0, bound] m."""
+    if not all(isinstance(d, (int, float)) and 0.0 < d <= bound for d in values):
+        raise ValueError(
+            f"GeneratorConfig.{name} must be distances in (0, {bound_name} = {bound}] m, got {values!r}"
+        )

@@ -48,6 +48,13 @@ def rotz(yaw: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def arm_clearance_offsets(root_R: np.ndarray, distances) -> list[np.ndarray]:
+    """World [2] root offsets sideways of the heading (root frame +-y) by each of `distances`
+    (m), nearest first, left before right."""
+    left = root_R[:2, 1]
+    return [sign * d * left for d in sorted(distances) for sign in (1.0, -1.0)]
+
+
 def placement_row(pos, rot) -> np.ndarray:
     """[7] xyz + quaternion xyzw of a placement (pos [3], rot [3, 3])."""
     return np.concatenate([pos, quat_xyzw_from_matrix_single(rot)])
@@ -156,6 +163,15 @@ class PostureProjection:
                     arms_hit |= hit
             if not arms_hit:
                 return None
+        # The last upper body's arm still meets the terrain: the root steps sideways off the
+        # guide, to either side (`arm_clearance_shifts`, within the usual root bounds).
+        for offset in arm_clearance_offsets(root_R, self.config.arm_clearance_shifts):
+            for one_air in airs:
+                built, _ = self._build(
+                    guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, one_air, upper
+                )
+                if built is not None:
+                    return built
         return None
 
     def _build(self, guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air, upper):

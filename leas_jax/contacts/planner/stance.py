@@ -38,7 +38,9 @@ def stance_shifts(distances) -> np.ndarray:
     """[8 x len(distances), 2] root-frame (forward, left) offsets of the soles' places: 8
     directions (45 degrees apart) at each distance, nearest first."""
     angles = np.arange(8) * (np.pi / 4)
-    return np.array([(d * np.cos(a), d * np.sin(a)) for d in sorted(distances) for a in angles]).reshape(-1, 2)
+    return np.array([(d * np.cos(a), d * np.sin(a)) for d in sorted(distances) for a in angles]).reshape(
+        -1, 2
+    )
 
 
 def shifted_stance(

@@ -18,13 +18,20 @@ describe the planning pose where it stopped (the first one after `last_valid_ind
 (`EnvConfig.spawns`); the default keeps the policy's own setting. Writes
 guide_failures.json and guide_failures.md into --out.
 
+`--compare BEFORE AFTER` runs nothing: it pairs two reports of the same policy, starts,
+seed and spawns (so the same guides, deterministic episodes), e.g. before and after a
+generator change, and writes <out>/paired.json: the guides one covers fully and the other
+does not ("fixed", "broken") and a two-sided sign test on those counts.
+
     python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 64 --workers 2 --what-if
+    python benchmarks/guide_failures.py --compare OLD/guide_failures.json NEW/guide_failures.json --out NEW
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 import re
 import sys
 from collections import Counter
@@ -95,6 +102,63 @@ def main_reason(reasons: dict) -> str:
     return max(reasons, key=reasons.get) if reasons else "none"
 
 
+def sign_test(fixed: int, broken: int) -> float:
+    """Two-sided exact sign test p-value of `fixed` against `broken` (1.0 without either)."""
+    n, k = fixed + broken, min(fixed, broken)
+    if n == 0:
+        return 1.0
+    tail = sum(math.comb(n, i) for i in range(k + 1)) / 2.0**n
+    return min(1.0, 2.0 * tail)
+
+
+def paired(before: dict, after: dict) -> dict:
+    """Guide-by-guide comparison of two reports of the same episodes (policy, starts, seed,
+    spawns): full coverage before and after, the guides fixed and broken, the sign test."""
+    from leas_jax.errors import UsageError
+
+    keys = ("policy", "starts", "seed", "spawns", "terrain")
+    differ = [k for k in keys if before.get(k) != after.get(k)]
+    if differ:
+        raise UsageError(
+            f"--compare: the reports differ in {', '.join(differ)}; only reports of the same episodes pair"
+        )
+    failed_before = {f["start"] for f in before["failures"]}
+    failed_after = {f["start"] for f in after["failures"]}
+    fixed, broken = sorted(failed_before - failed_after), sorted(failed_after - failed_before)
+    return {
+        **{k: after[k] for k in keys},
+        "full_coverage_before": before["full_coverage"],
+        "full_coverage_after": after["full_coverage"],
+        "fixed": fixed,
+        "broken": broken,
+        "p_sign_test": sign_test(len(fixed), len(broken)),
+    }
+
+
+def compare(paths, out: Path) -> dict:
+    """`--compare`: pair two guide_failures.json reports, print and save <out>/paired.json."""
+    import json
+
+    from common import load_average, save
+
+    from leas_jax.errors import UsageError
+
+    reports = []
+    for path in paths:
+        try:
+            reports.append(json.loads(Path(path).read_text()))
+        except (OSError, ValueError) as error:
+            raise UsageError(f"--compare: cannot read {path} ({error})") from None
+    result = {"before": str(paths[0]), "after": str(paths[1]), **paired(*reports)}
+    save("paired", result, load_average(), out)
+    print(
+        f"{result['policy']}: {100 * result['full_coverage_before']:.1f} -> "
+        f"{100 * result['full_coverage_after']:.1f} % fully covered; fixed {len(result['fixed'])}, "
+        f"broken {len(result['broken'])} (sign test p = {result['p_sign_test']:.2g})"
+    )
+    return result
+
+
 def main(argv=None) -> dict:
     from common import add_out_argument, load_average, save, wilson
 
@@ -117,8 +181,13 @@ def main(argv=None) -> dict:
     parser.add_argument(
         "--slow-factor", type=int, default=2, help="what-if: the failed guides this much slower"
     )
+    parser.add_argument(
+        "--compare", nargs=2, metavar=("BEFORE", "AFTER"), help="pair two reports (runs nothing)"
+    )
     add_out_argument(parser)
     args = parser.parse_args(argv)
+    if args.compare:
+        return compare(args.compare, Path(args.out))
     try:
         base = GeneratorConfig(upper_bodies=tuple(name for name in args.upper_bodies.split(",") if name))
     except ValueError as error:

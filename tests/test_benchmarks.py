@@ -138,3 +138,32 @@ def test_guide_failures_report_names_why_the_generator_stopped():
     assert "upper bodies half_sitting" in text
     assert "| terrain collision: arm | 1 |" in text
     assert "met the terrain or the legs at the failure: 1 / 1" in text
+
+
+def test_guide_failures_compare_pairs_the_same_episodes(tmp_path):
+    import guide_failures
+
+    from leas_jax.errors import UsageError
+
+    assert guide_failures.sign_test(0, 0) == 1.0
+    assert guide_failures.sign_test(14, 0) == pytest.approx(2 * 0.5**14)
+    assert guide_failures.sign_test(3, 3) == 1.0
+    same = {"policy": "p", "starts": 4, "seed": 0, "spawns": "condition", "terrain": "t"}
+    before = {**same, "full_coverage": 0.25, "failures": [{"start": k} for k in (0, 1, 2)]}
+    after = {**same, "full_coverage": 0.5, "failures": [{"start": k} for k in (2, 3)]}
+    for name, report in (("b.json", before), ("a.json", after)):
+        (tmp_path / name).write_text(json.dumps(report))
+    result = guide_failures.main(
+        ["--compare", str(tmp_path / "b.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
+    )
+    assert result["fixed"] == [0, 1] and result["broken"] == [3]
+    assert json.loads((tmp_path / "paired.json").read_text())["p_sign_test"] == pytest.approx(1.0)
+    (tmp_path / "o.json").write_text(json.dumps({**after, "seed": 1}))
+    with pytest.raises(UsageError, match="seed"):
+        guide_failures.main(
+            ["--compare", str(tmp_path / "b.json"), str(tmp_path / "o.json"), "--out", str(tmp_path)]
+        )
+    with pytest.raises(UsageError, match="missing.json"):
+        guide_failures.main(
+            ["--compare", str(tmp_path / "missing.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
+        )

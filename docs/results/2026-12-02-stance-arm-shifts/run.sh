@@ -26,3 +26,10 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
 # 4. Table II's RBKino and RBLin, 60 starts per cell (1 min).
 PYTHONPATH=$PWD python benchmarks/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
   --variants rblin,rbkino --sweep-steps ""
+
+# 5. Each policy's guides paired with the step-fallback generator's verdicts on the same episodes.
+for P in shipped pretrain learned_arms_s0; do
+  PYTHONPATH=$PWD python benchmarks/guide_failures.py \
+    --compare docs/results/2026-12-02-step-fallback/guides/$P/guide_failures.json \
+    $D/guides/$P/guide_failures.json --out $D/guides/$P
+done

@@ -259,8 +259,10 @@ def test_upper_bodies_must_be_known_postures():
 
 
 def test_turning_too_fast_stops():
-    """1.5 rad/s while walking: 0.75 rad per planning pose (stride 5), more than two
-    steps can follow (hip yaw 0.35 rad inward); pi/9 rad/s (paper's omega_max) passes."""
+    """4 rad/s while walking: 0.4 rad per guide pose, more than two steps can follow even
+    at every guide pose (hip yaw 0.35 rad inward); 1.5 rad/s, 0.75 rad per planning pose
+    (stride 5), is followed only through the guide poses between (`refine_stride`); pi/9
+    rad/s (paper's omega_max) passes."""
 
     def turning(rate, count=100):
         yaw = rate * DT * np.arange(count)
@@ -268,8 +270,11 @@ def test_turning_too_fast_stops():
         y = np.cumsum(0.1 * DT * np.sin(yaw))
         return np.stack([x, y, np.full(count, H), yaw], axis=1)
 
+    assert plan_contacts(FLAT, turning(4.0), DT).coverage < 0.5
     fast = plan_contacts(FLAT, turning(1.5), DT)
-    assert fast.coverage < 0.5
+    assert fast.coverage == 1.0
+    assert verify(fast).ok
+    assert plan_contacts(FLAT, turning(1.5), DT, GeneratorConfig(refine_stride=None)).coverage < 0.5
     slow = plan_contacts(FLAT, turning(np.pi / 9), DT)
     assert slow.coverage == 1.0
     assert verify(slow).ok
@@ -412,7 +417,10 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
     assert plan.coverage == 1.0
     assert verify(plan).ok
     held_under = plan_contacts(
-        circuit, data["guide"], float(data["timestep"]), GeneratorConfig(swing_clearance=0.0)
+        circuit,
+        data["guide"],
+        float(data["timestep"]),
+        GeneratorConfig(swing_clearance=0.0, refine_stride=None),
     )
     assert held_under.last_valid_index == 160
 
@@ -429,7 +437,9 @@ def test_a_step_falls_back_to_the_place_under_the_root():
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    no_fallback = plan_contacts(_arena(), guide, timestep, GeneratorConfig(fallback_lookahead=None))
+    no_fallback = plan_contacts(
+        _arena(), guide, timestep, GeneratorConfig(fallback_lookahead=None, refine_stride=None)
+    )
     assert no_fallback.last_valid_index == 115
 
 
@@ -449,14 +459,18 @@ def test_single_support_over_a_far_stance_sole():
     offsets = np.hypot(*(plan.q[:, :2] - guide[plan.guide_index, :2]).T)
     assert offsets[~in_air].max() <= GeneratorConfig().max_root_offset_xy + 1e-6
     assert 0.12 < offsets[in_air].max() <= GeneratorConfig().max_single_support_offset_xy + 1e-6
-    held = plan_contacts(_arena(), guide, timestep, GeneratorConfig(max_single_support_offset_xy=0.12))
+    held = plan_contacts(
+        _arena(), guide, timestep, GeneratorConfig(max_single_support_offset_xy=0.12, refine_stride=None)
+    )
     assert held.last_valid_index == 200
 
 
 def _earlier(**changes) -> GeneratorConfig:
-    """The generator before its step fallback and single-support root bound, with `changes`:
-    for tests that show what an earlier feature was needed for."""
-    return GeneratorConfig(fallback_lookahead=None, max_single_support_offset_xy=0.12, **changes)
+    """The generator before its step fallback, single-support root bound and refined planning
+    poses, with `changes`: for tests that show what an earlier feature was needed for."""
+    return GeneratorConfig(
+        fallback_lookahead=None, max_single_support_offset_xy=0.12, refine_stride=None, **changes
+    )
 
 
 def _arena():
@@ -521,7 +535,27 @@ def test_root_steps_sideways_off_a_pillar_the_arms_meet():
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    held = plan_contacts(_arena(), guide, timestep, GeneratorConfig(arm_clearance_shifts=()))
+    held = plan_contacts(
+        _arena(), guide, timestep, GeneratorConfig(arm_clearance_shifts=(), refine_stride=None)
+    )
     assert held.last_valid_index == 5
     with pytest.raises(ValueError, match="arm_clearance_shifts"):
         GeneratorConfig(arm_clearance_shifts=(0.0,))
+
+
+def test_a_fast_turn_is_followed_through_the_poses_between():
+    """RBKino (HPP's kinodynamic steering) from rest turned 90 degrees away from a goal 4 m
+    off, setting off at 0.04 m/s: its root turns by most of that within the first 0.5 s,
+    so at the first planning pose the feet, still at the start yaw, are past the hip-yaw
+    and comfort limits and the plan stopped at the first pose. Planned again at every guide
+    pose of that half-second (`GeneratorConfig.refine_stride`), the feet turn through the
+    yaws on the way and the whole guide is covered and verified."""
+    from leas_jax.steering.rbkino import rbkino_planar
+
+    planar = rbkino_planar((0.0, 0.0, np.pi / 2), (4.0, 0.0), initial_speed=0.04)
+    guide = np.column_stack([planar[:, :2], np.full(len(planar), H), planar[:, 2]])
+    assert abs(guide[5, 3] - guide[0, 3]) > 0.8  # rad turned in the first 0.5 s
+    plan = plan_contacts(FLAT, guide, DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    assert plan_contacts(FLAT, guide, DT, GeneratorConfig(refine_stride=None)).last_valid_index == 0

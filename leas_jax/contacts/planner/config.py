@@ -17,6 +17,15 @@ class GeneratorConfig:
     """
 
     stride: int = 5  # guide poses per planning pose, docs/design.md §6 ("every 5th pose by default")
+    # Where a planning pose cannot be reached from the last one, the generator plans again at
+    # every this-many guide poses between them. A root turning 30-100 degrees within 0.5 s
+    # (RBKino starting turned away from its goal, Table II) leaves the feet beyond the hip-yaw
+    # and comfort limits at the next planning pose; stepping at the yaws on the way follows
+    # it. HPP's generator, which the paper's Table II used, samples the guide every 0.01 s
+    # (hpp-rbprm-corba's abstract_contact_generator.py, `dt`), with no bound on the steps
+    # per second (docs/results/2026-12-02-refined-planning-poses;
+    # test_a_fast_turn_is_followed_through_the_poses_between). None: never.
+    refine_stride: int | None = 1
     lookahead: float = 0.7  # s, where a moving foot should land on the guide, docs/design.md §6 (0.6-0.8 s)
     # s, where a step aims when no foothold near the `lookahead` target gives a posture: the
     # foot's place under the planning pose itself. A guide drifting sideways puts the
@@ -129,6 +138,12 @@ class GeneratorConfig:
             raise ValueError(
                 f"GeneratorConfig.upper_bodies must name one or more of {sorted(UPPER_BODY_POSTURES)}, "
                 f"got {self.upper_bodies!r}"
+            )
+        if self.refine_stride is not None and not (
+            isinstance(self.refine_stride, int) and self.refine_stride >= 1
+        ):
+            raise ValueError(
+                f"GeneratorConfig.refine_stride must be None or an int >= 1, got {self.refine_stride!r}"
             )
         _check_distances("stance_shifts", self.stance_shifts, "max_root_offset_xy", self.max_root_offset_xy)
         _check_distances(

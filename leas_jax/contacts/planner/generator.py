@@ -107,26 +107,40 @@ class ContactGenerator:
         cfg = self.config
         postures: list[ContactPosture] = []
         last_valid = -1
-        rejections = self.projection.rejections  # counted per planning pose (`stop_reasons`)
-        if rejections is not None:
-            rejections.clear()
+        if self.projection.rejections is not None:
+            self.projection.rejections.clear()
         start = self._stance(guide[0])
         if start is not None:
             feet, first = start
             postures.append(first)
             last_valid = 0
-            indices = list(range(cfg.stride, len(guide), cfg.stride))
-            if len(guide) > 1 and (not indices or indices[-1] != len(guide) - 1):
-                indices.append(len(guide) - 1)
-            for index in indices:
-                if rejections is not None:
-                    rejections.clear()
-                added = self.walking.advance(guide, timestep, index, feet)
+            for index in planning_indices(len(guide), cfg.stride):
+                added = self._advance(guide, timestep, index, feet)
                 if added is None:
-                    break
+                    # plan again at the guide poses between: the feet follow a fast turn
+                    # through the root's yaws on the way
+                    for finer in refined_indices(last_valid, index, cfg.refine_stride):
+                        added = self._advance(guide, timestep, finer, feet)
+                        if added is None:
+                            break
+                        postures.extend(added)
+                        last_valid = finer
+                    if last_valid != index:
+                        break
+                    continue
                 postures.extend(added)
                 last_valid = index
         return self._make_plan(guide, timestep, postures, last_valid)
+
+    def _advance(self, guide, timestep, index: int, feet) -> list[ContactPosture] | None:
+        """`Walking.advance` to planning pose `index`; `feet` is left as it was where it fails."""
+        if self.projection.rejections is not None:
+            self.projection.rejections.clear()  # counted per planning pose (`stop_reasons`)
+        before = list(feet)
+        added = self.walking.advance(guide, timestep, index, feet)
+        if added is None:
+            feet[:] = before
+        return added
 
     def stop_reasons(self, guide, timestep: float) -> tuple[ContactPlan, Counter]:
         """A guide's plan, and why it stops: the checks that rejected the postures tried at
@@ -168,6 +182,24 @@ class ContactGenerator:
             guide=guide,
             timestep=timestep,
         )
+
+
+def planning_indices(length: int, stride: int) -> list[int]:
+    """Guide indices the generator plans at after the first pose: every `stride`-th, and the last."""
+    indices = list(range(stride, length, stride))
+    if length > 1 and (not indices or indices[-1] != length - 1):
+        indices.append(length - 1)
+    return indices
+
+
+def refined_indices(last_valid: int, failed: int, stride: int | None) -> list[int]:
+    """Guide indices to plan at, every `stride`-th after `last_valid` and ending at `failed`,
+    where planning pose `failed` could not be reached from `last_valid`; empty where that
+    is no finer (stride None, or not below the gap)."""
+    if stride is None or stride >= failed - last_valid:
+        return []
+    indices = list(range(last_valid + stride, failed, stride))
+    return indices + [failed]
 
 
 _GENERATORS: dict = {}

@@ -27,3 +27,11 @@ leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint
   --workers 2 --no-progress --out $D/pillars
 leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --no-progress \
   --out $D/evaluate_shipped
+
+# 4. The day's three generator changes together: paired with docs/results/2026-12-02-step-fallback.
+for P in shipped pretrain learned_arms_s0; do
+  mkdir -p $D/guides/$P/since_step_fallback
+  PYTHONPATH=$PWD python benchmarks/guide_failures.py \
+    --compare docs/results/2026-12-02-step-fallback/guides/$P/guide_failures.json \
+    $D/guides/$P/guide_failures.json --out $D/guides/$P/since_step_fallback
+done

@@ -35,3 +35,7 @@ for P in shipped pretrain learned_arms_s0; do
     --compare docs/results/2026-12-02-step-fallback/guides/$P/guide_failures.json \
     $D/guides/$P/guide_failures.json --out $D/guides/$P/since_step_fallback
 done
+
+# 5. The learned condition relabelled on this generator's walking truth (labels cached in
+#    .cache/, 24 000 poses), fitted and validated; writes checkpoints/feasibility/walking.npz.
+PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/feasibility

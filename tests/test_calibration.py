@@ -186,14 +186,15 @@ def test_walking_truth_rejects_crouched_roots_the_static_truth_accepts():
 
 
 def test_hands_term_catches_grippers_beside_the_wall():
-    """Roots 0.35 m from the wall's face, heading along it: the trunk cylinder (0.30 m) is
-    clear, but a half-sitting gripper (0.55 m sideways) is in the wall, so the generator
-    cannot stand there. The hands term rejects them; its NumPy form in the search agrees
-    with the jitted condition, and a search over the hands grid turns the term on."""
+    """Roots 0.22 m from the wall's face, heading along it: a trunk cylinder of 0.20 m is
+    clear, but a half-sitting gripper (0.55 m sideways) is in the wall, and so are the
+    shoulders (0.37 m) with the arms held in and the root shifted its 0.12 m off: the
+    generator cannot stand there. The hands term rejects them; its NumPy form in the search
+    agrees with the jitted condition, and a search over the hands grid turns the term on."""
     rng = np.random.default_rng(4)
     side = np.column_stack(
         [
-            np.full(6, 4.3 - 0.35),
+            np.full(6, 4.3 - 0.22),
             rng.uniform(2.0, 4.0, 6),
             np.full(6, 1.0),
             rng.choice([-math.pi / 2, math.pi / 2], 6),
@@ -202,7 +203,7 @@ def test_hands_term_catches_grippers_beside_the_wall():
     poses = np.concatenate([POSES[:16], side])
     truth = rc.ground_truth(TERRAIN, poses, workers=1)
     assert truth[:16].all() and not truth[16:].any()
-    base = ReachabilityConfig(**REACHABILITY_TERMS_OFF)  # the default cylinders alone
+    base = ReachabilityConfig(trunk_radius=0.20, **REACHABILITY_TERMS_OFF)  # cylinders alone
     assert rc.condition(TERRAIN, poses, base).all()  # every pose passes without the hands
     hands = dataclasses.replace(base, hand_radius=0.13)
     predicted = rc.condition(TERRAIN, poses, hands)
@@ -217,14 +218,14 @@ def test_hands_term_catches_grippers_beside_the_wall():
         predicted,
     )
     grid = {
-        "trunk_radius": (0.30,),
+        "trunk_radius": (0.20,),
         "leg_radius": (0.05,),
         "trunk_bottom": (base.trunk_bottom,),
         "leg_bottom": (base.leg_bottom,),
         "leg_top": (base.leg_top,),
     }
     terms = {
-        "trunk_radius": (0.30,),
+        "trunk_radius": (0.20,),
         "leg_radius": (0.05,),
         "leg_forward": (0.0,),
         "foothold": (None,),

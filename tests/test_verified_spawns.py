@@ -14,9 +14,11 @@ from leas_jax.feasibility import spawns
 from leas_jax.terrain.loader import loads_terrain
 from leas_jax.training.config import TRAINING_REACHABILITY
 
-# 2.4 x 2.4 m of flat ground and a 0.20 m pillar at its centre: the presets' trunk cylinder
-# (0.30 m) keeps its spawn points 0.40 m from the pillar's axis, where Talos's grippers
-# (half-sitting, ~0.45 m to the side) hit it at some yaws.
+# 2.4 x 2.4 m of flat ground and a 0.20 m pillar at its centre: a trunk cylinder of 0.20 m
+# keeps its spawn points 0.30 m from the pillar's axis, 0.20 m from its face, where Talos's
+# shoulders (0.37 m to the side even with the arms held in, 0.25 m with the root shifted
+# its 0.12 m off the guide) meet it at some yaws. (The presets' 0.30 m cylinder keeps them
+# where the generator now stands at every yaw.)
 PILLAR = """
 name = "pillar_pad"
 bounds = [[0.0, 0.0], [2.4, 2.4]]
@@ -31,7 +33,9 @@ size = [2.4, 2.4, 1.0]
 center = [1.2, 1.2, 0.8]
 size = [0.2, 0.2, 1.6]
 """
-CONFIG = EnvConfig(reachability=TRAINING_REACHABILITY, spawns="generator")
+CONFIG = EnvConfig(
+    reachability=dataclasses.replace(TRAINING_REACHABILITY, trunk_radius=0.20), spawns="generator"
+)
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +98,7 @@ def test_verdicts_are_cached_and_rebuilt_when_the_generator_changes(pillar, veri
     again = spawns.arena_field(pillar, CONFIG, workers=0, progress=False)
     np.testing.assert_array_equal(np.asarray(again.spawn_yaw), np.asarray(field.spawn_yaw))
     poses = spawns.candidate_poses(
-        spawns.arena_field(pillar, EnvConfig(reachability=TRAINING_REACHABILITY)), CONFIG
+        spawns.arena_field(pillar, dataclasses.replace(CONFIG, spawns="condition")), CONFIG
     )
     assert spawns.spawn_key(pillar.text, poses, GeneratorConfig()) != spawns.spawn_key(
         pillar.text, poses, GeneratorConfig(max_foot_yaw=0.4)
@@ -116,7 +120,7 @@ def test_an_interrupted_build_resumes(pillar, tmp_path, monkeypatch):
     monkeypatch.setenv("LEAS_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(spawns, "CHUNK", 50)
     poses = spawns.candidate_poses(
-        spawns.arena_field(pillar, EnvConfig(reachability=TRAINING_REACHABILITY)), CONFIG
+        spawns.arena_field(pillar, dataclasses.replace(CONFIG, spawns="condition")), CONFIG
     )
     poses = poses[:120]
     batches, interrupt = [], [True]

@@ -432,8 +432,7 @@ def test_a_step_falls_back_to_the_place_under_the_root():
     ahead gives a posture, nor does the right foot's step; the plan stopped at pose 115.
     A step toward the foot's place under the planning pose itself
     (`GeneratorConfig.fallback_lookahead`) passes, and the whole guide is covered."""
-    data = np.load(Path(__file__).parent / "data" / "training_arena_stairs_pit_fallback_leas_guide.npz")
-    guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
+    guide, timestep = _arena_guide("stairs_pit_fallback")
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok
@@ -450,8 +449,7 @@ def test_single_support_over_a_far_stance_sole():
     comfort region but far from the guide root. Held to `max_root_offset_xy` (0.12 m) the plan stopped
     at pose 200; with `max_single_support_offset_xy` the whole guide is covered, and `verify`
     holds every single-support root to that bound."""
-    data = np.load(Path(__file__).parent / "data" / "training_arena_rubble_single_support_leas_guide.npz")
-    guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
+    guide, timestep = _arena_guide("rubble_single_support")
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok
@@ -471,6 +469,12 @@ def _earlier(**changes) -> GeneratorConfig:
     return GeneratorConfig(
         fallback_lookahead=None, max_single_support_offset_xy=0.12, refine_stride=None, **changes
     )
+
+
+def _arena_guide(what: str) -> tuple[np.ndarray, float]:
+    """(guide [T, 4] float64, timestep s) of tests/data/training_arena_<what>_leas_guide.npz."""
+    data = np.load(Path(__file__).parent / "data" / f"training_arena_{what}_leas_guide.npz")
+    return data["guide"].astype(np.float64), float(data["timestep"])
 
 
 def _arena():
@@ -530,8 +534,7 @@ def test_root_steps_sideways_off_a_pillar_the_arms_meet():
     plan stopped at pose 5. With the root shifted sideways off the guide
     (`GeneratorConfig.arm_clearance_shifts`, within the usual root bounds) the whole guide is
     covered and verified."""
-    data = np.load(Path(__file__).parent / "data" / "training_arena_pillars_arm_clearance_leas_guide.npz")
-    guide, timestep = data["guide"].astype(np.float64), float(data["timestep"])
+    guide, timestep = _arena_guide("pillars_arm_clearance")
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok

@@ -115,22 +115,26 @@ class ContactGenerator:
             postures.append(first)
             last_valid = 0
             for index in planning_indices(len(guide), cfg.stride):
-                added = self._advance(guide, timestep, index, feet)
-                if added is None:
-                    # plan again at the guide poses between: the feet follow a fast turn
-                    # through the root's yaws on the way
-                    for finer in refined_indices(last_valid, index, cfg.refine_stride):
-                        added = self._advance(guide, timestep, finer, feet)
-                        if added is None:
-                            break
-                        postures.extend(added)
-                        last_valid = finer
-                    if last_valid != index:
-                        break
-                    continue
-                postures.extend(added)
-                last_valid = index
+                last_valid = self._reach(guide, timestep, last_valid, index, feet, postures)
+                if last_valid != index:
+                    break
         return self._make_plan(guide, timestep, postures, last_valid)
+
+    def _reach(self, guide, timestep, last_valid: int, index: int, feet, postures: list) -> int:
+        """Plan from guide pose `last_valid` to planning pose `index`, appending to `postures`
+        (mutates `feet`): directly, else through `refined_indices` (the feet follow a fast
+        turn through the root's yaws on the way). Returns the last guide index reached."""
+        added = self._advance(guide, timestep, index, feet)
+        if added is not None:
+            postures.extend(added)
+            return index
+        for finer in refined_indices(last_valid, index, self.config.refine_stride):
+            added = self._advance(guide, timestep, finer, feet)
+            if added is None:
+                break
+            postures.extend(added)
+            last_valid = finer
+        return last_valid
 
     def _advance(self, guide, timestep, index: int, feet) -> list[ContactPosture] | None:
         """`Walking.advance` to planning pose `index`; `feet` is left as it was where it fails."""

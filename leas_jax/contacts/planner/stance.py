@@ -57,19 +57,25 @@ def shifted_stance(
     root_R = rotz(pose[3])
     for offset in stance_shifts(config.stance_shifts):
         shift = root_R[:2, :2] @ offset
-        moved = np.array([pose[0] + shift[0], pose[1] + shift[1], pose[2], pose[3]])
-        left_target, left_yaw = footholds.nominal_placement(moved, LEFT)
-        right_target, right_yaw = footholds.nominal_placement(moved, RIGHT)
-        left = footholds.first_candidate(LEFT, moved, left_target, left_yaw)
-        if left is None:
+        soles = first_soles(footholds, np.array([pose[0] + shift[0], pose[1] + shift[1], pose[2], pose[3]]))
+        if soles is None:
             continue
-        right = footholds.first_candidate(RIGHT, moved, right_target, right_yaw, left)
-        if right is None:
-            continue
-        posture = projection.posture(pose, 0, [(LEFT, *left), (RIGHT, *right)])
+        posture = projection.posture(pose, 0, [(LEFT, *soles[0]), (RIGHT, *soles[1])])
         if posture is not None:
-            return [left, right], posture
+            return soles, posture
     return None
+
+
+def first_soles(footholds: Footholds, pose) -> list | None:
+    """[left, right] the first candidate of each foot at its nominal place under `pose` [4]
+    (the right one's avoids the left one), or None where a foot has none."""
+    left_target, left_yaw = footholds.nominal_placement(pose, LEFT)
+    left = footholds.first_candidate(LEFT, pose, left_target, left_yaw)
+    if left is None:
+        return None
+    right_target, right_yaw = footholds.nominal_placement(pose, RIGHT)
+    right = footholds.first_candidate(RIGHT, pose, right_target, right_yaw, left)
+    return None if right is None else [left, right]
 
 
 def nominal_stance(
@@ -91,19 +97,15 @@ def nominal_stance(
         ([left, right] sole placements (pos [3], rot [3, 3]), the posture, guide_index 0),
         or None where the generator cannot stand there.
     """
+    soles = first_soles(footholds, pose)
+    if soles is None:
+        projection.count_rejection("no foothold")
+        return None
+    posture = projection.posture(pose, 0, [(LEFT, *soles[0]), (RIGHT, *soles[1])])
+    if posture is not None:
+        return soles, posture
     left_target, left_yaw = footholds.nominal_placement(pose, LEFT)
     right_target, right_yaw = footholds.nominal_placement(pose, RIGHT)
-    left = footholds.first_candidate(LEFT, pose, left_target, left_yaw)
-    if left is None:
-        projection.count_rejection("no foothold")
-        return None
-    right = footholds.first_candidate(RIGHT, pose, right_target, right_yaw, left)
-    if right is None:
-        projection.count_rejection("no foothold")
-        return None
-    posture = projection.posture(pose, 0, [(LEFT, *left), (RIGHT, *right)])
-    if posture is not None:
-        return [left, right], posture
     lefts = list(zip(*footholds.candidates(LEFT, pose, left_target, left_yaw)))
     rights = {}  # left rank -> right candidates avoiding that left sole
     pairs = sorted(

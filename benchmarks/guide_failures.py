@@ -18,6 +18,9 @@ describe the planning pose where it stopped (the first one after `last_valid_ind
 (`EnvConfig.spawns`); the default keeps the policy's own setting. Writes
 guide_failures.json and guide_failures.md into --out.
 
+`--set NAME=VALUE` (repeatable) changes one GeneratorConfig field for the run, e.g. the
+generator as it was before a change, to pair with it on other evaluation seeds.
+
 `--compare BEFORE AFTER` runs nothing: it pairs two reports of the same policy, starts,
 seed and spawns (so the same guides, deterministic episodes), e.g. before and after a
 generator change, and writes <out>/paired.json: the guides one covers fully and the other
@@ -95,6 +98,27 @@ def slowed(guide: np.ndarray, factor: int) -> np.ndarray:
     fine = np.linspace(0.0, len(guide) - 1, (len(guide) - 1) * factor + 1)
     yaw = np.unwrap(guide[:, 3])
     return np.stack([np.interp(fine, t, c) for c in (guide[:, 0], guide[:, 1], guide[:, 2], yaw)], axis=1)
+
+
+def generator_settings(assignments: list[str], parser) -> dict:
+    """{field: value} from `--set NAME=VALUE` arguments (VALUE a Python literal); a
+    malformed one, or a name GeneratorConfig has not, ends the run naming it."""
+    import ast
+
+    from leas_jax.contacts.planner.config import GeneratorConfig
+
+    fields = {f.name for f in dataclasses.fields(GeneratorConfig)}
+    settings = {}
+    for assignment in assignments:
+        name, sep, text = assignment.partition("=")
+        name = name.strip()
+        if not sep or name not in fields:
+            parser.error(f"--set {assignment!r}: expected NAME=VALUE with NAME a GeneratorConfig field")
+        try:
+            settings[name] = ast.literal_eval(text.strip())
+        except (ValueError, SyntaxError):
+            parser.error(f"--set {assignment!r}: VALUE must be a Python literal")
+    return settings
 
 
 def main_reason(reasons: dict) -> str:
@@ -176,6 +200,14 @@ def main(argv=None) -> dict:
         help="comma-separated upper-body postures the generator may hold (GeneratorConfig.upper_bodies)",
     )
     parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a GeneratorConfig field for this run, VALUE a Python literal "
+        "(e.g. --set 'retry_settings=()' --set max_candidates=12); repeatable",
+    )
+    parser.add_argument(
         "--what-if", action="store_true", help="re-plan the failed guides with other settings"
     )
     parser.add_argument(
@@ -188,10 +220,13 @@ def main(argv=None) -> dict:
     args = parser.parse_args(argv)
     if args.compare:
         return compare(args.compare, Path(args.out))
+    settings = generator_settings(args.set, parser)
     try:
-        base = GeneratorConfig(upper_bodies=tuple(name for name in args.upper_bodies.split(",") if name))
-    except ValueError as error:
-        parser.error(f"--upper-bodies: {error}")
+        base = GeneratorConfig(
+            upper_bodies=tuple(name for name in args.upper_bodies.split(",") if name), **settings
+        )
+    except (TypeError, ValueError) as error:
+        parser.error(f"--upper-bodies / --set: {error}")
     load_before = load_average()
 
     from leas_jax.contacts.planner.generator import ContactGenerator
@@ -260,6 +295,7 @@ def main(argv=None) -> dict:
         "policy": str(args.policy),
         "terrain": arena.name,
         "upper_bodies": list(base.upper_bodies),
+        "generator_settings": {name: repr(value) for name, value in settings.items()},
         "spawns": env.spawns,
         "starts": args.starts,
         "seed": args.seed,
@@ -301,8 +337,9 @@ def markdown(report: dict) -> str:
     lo, hi = report["full_coverage_95ci"]
     lines = [
         f"Policy {report['policy']} on {report['terrain']}, spawns {report['spawns']}, "
-        f"generator upper bodies {', '.join(report['upper_bodies'])}, "
-        f"{report['starts']} starts (seed {report['seed']}): "
+        f"generator upper bodies {', '.join(report['upper_bodies'])}"
+        + "".join(f", {name}={value}" for name, value in report.get("generator_settings", {}).items())
+        + f", {report['starts']} starts (seed {report['seed']}): "
         f"{100 * report['full_coverage']:.1f} % [{100 * lo:.1f}, {100 * hi:.1f}] of guides fully covered, "
         f"mean coverage {100 * report['mean_coverage']:.1f} %; {report['failed_at_first_pose']} guides "
         f"fail at their first pose; mean progress along the target direction "

@@ -140,6 +140,26 @@ def test_guide_failures_report_names_why_the_generator_stopped():
     assert "met the terrain or the legs at the failure: 1 / 1" in text
 
 
+def test_guide_failures_sets_generator_fields_from_the_command_line():
+    import argparse
+
+    import guide_failures
+
+    parser = argparse.ArgumentParser()
+    settings = guide_failures.generator_settings(["retry_settings=()", "max_candidates = 12"], parser)
+    assert settings == {"retry_settings": (), "max_candidates": 12}
+    for bad in ("no_such_field=1", "max_candidates", "lookahead=fast"):
+        with pytest.raises(SystemExit):
+            guide_failures.generator_settings([bad], parser)
+    report = {"policy": "p", "terrain": "t", "spawns": "condition", "upper_bodies": ["half_sitting"]}
+    report |= {"generator_settings": {"max_candidates": "12"}, "starts": 1, "seed": 0}
+    report |= {"full_coverage": 1.0, "full_coverage_95ci": [0.2, 1.0], "mean_coverage": 1.0}
+    report |= {"failed_at_first_pose": 0, "mean_progress_m": 1.0, "valid_fraction": 1.0}
+    report |= {"failures_by_cell": {}, "cells_visited": {}, "failures_by_reason": {}}
+    report |= {"failures_with_an_arm_collision": 0, "failures": [], "what_if": {}}
+    assert "half_sitting, max_candidates=12, 1 starts" in guide_failures.markdown(report)
+
+
 def test_guide_failures_compare_pairs_the_same_episodes(tmp_path):
     import guide_failures
 

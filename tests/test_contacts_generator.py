@@ -136,7 +136,7 @@ def test_bridge_crossed_by_a_guide_off_its_centre_line():
     feet = plan.feet[:, :, :2]
     on_bridge = np.isfinite(feet[..., 0]) & (feet[..., 0] > 2.1) & (feet[..., 0] < 3.9)
     assert np.all(feet[:, 0, 1][on_bridge[:, 0]] > 0.0) and np.all(feet[:, 1, 1][on_bridge[:, 1]] < 0.0)
-    without_lanes = plan_contacts(bridge, guide, DT, GeneratorConfig(beam_align_yaw=0.0))
+    without_lanes = plan_contacts(bridge, guide, DT, _narrow(beam_align_yaw=0.0))
     assert without_lanes.coverage < 1.0 and x_at(without_lanes, without_lanes.last_valid_index) < 2.2
 
 
@@ -217,9 +217,7 @@ def test_single_support_with_a_shorter_root_shift_passes_a_pillar():
         terrain,
         guide,
         DT,
-        GeneratorConfig(
-            single_support_com_inset=None, upper_bodies=("half_sitting",), arm_clearance_shifts=()
-        ),
+        _narrow(single_support_com_inset=None, upper_bodies=("half_sitting",), arm_clearance_shifts=()),
     )
     assert centred.coverage < 0.6
     plan = plan_contacts(terrain, guide, DT)
@@ -420,7 +418,7 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
         circuit,
         data["guide"],
         float(data["timestep"]),
-        GeneratorConfig(swing_clearance=0.0, refine_stride=None),
+        _narrow(swing_clearance=0.0, refine_stride=None),
     )
     assert held_under.last_valid_index == 160
 
@@ -437,7 +435,7 @@ def test_a_step_falls_back_to_the_place_under_the_root():
     assert plan.coverage == 1.0
     assert verify(plan).ok
     no_fallback = plan_contacts(
-        _arena(), guide, timestep, GeneratorConfig(fallback_lookahead=None, refine_stride=None)
+        _arena(), guide, timestep, _narrow(fallback_lookahead=None, refine_stride=None)
     )
     assert no_fallback.last_valid_index == 115
 
@@ -458,7 +456,7 @@ def test_single_support_over_a_far_stance_sole():
     assert offsets[~in_air].max() <= GeneratorConfig().max_root_offset_xy + 1e-6
     assert 0.12 < offsets[in_air].max() <= GeneratorConfig().max_single_support_offset_xy + 1e-6
     held = plan_contacts(
-        _arena(), guide, timestep, GeneratorConfig(max_single_support_offset_xy=0.12, refine_stride=None)
+        _arena(), guide, timestep, _narrow(max_single_support_offset_xy=0.12, refine_stride=None)
     )
     assert held.last_valid_index == 200
 
@@ -466,9 +464,21 @@ def test_single_support_over_a_far_stance_sole():
 def _earlier(**changes) -> GeneratorConfig:
     """The generator before its step fallback, single-support root bound and refined planning
     poses, with `changes`: for tests that show what an earlier feature was needed for."""
-    return GeneratorConfig(
-        fallback_lookahead=None, max_single_support_offset_xy=0.12, refine_stride=None, **changes
+    return _narrow(fallback_lookahead=None, max_single_support_offset_xy=0.12, refine_stride=None, **changes)
+
+
+def _narrow(**changes) -> GeneratorConfig:
+    """The generator's step search before its wider candidates and comfort region and its
+    retries (`retry_settings`), with `changes`: for tests that show what a feature is needed
+    for; the wider search passes some of their counterfactuals by another way."""
+    settings = dict(
+        max_foot_offset=0.25,
+        max_single_support_offset_xy=0.20,
+        candidate_radius=0.15,
+        max_candidates=12,
+        retry_settings=(),
     )
+    return GeneratorConfig(**{**settings, **changes})
 
 
 def _arena_guide(what: str) -> tuple[np.ndarray, float]:
@@ -538,9 +548,7 @@ def test_root_steps_sideways_off_a_pillar_the_arms_meet():
     plan = plan_contacts(_arena(), guide, timestep)
     assert plan.coverage == 1.0
     assert verify(plan).ok
-    held = plan_contacts(
-        _arena(), guide, timestep, GeneratorConfig(arm_clearance_shifts=(), refine_stride=None)
-    )
+    held = plan_contacts(_arena(), guide, timestep, _narrow(arm_clearance_shifts=(), refine_stride=None))
     assert held.last_valid_index == 5
     with pytest.raises(ValueError, match="arm_clearance_shifts"):
         GeneratorConfig(arm_clearance_shifts=(0.0,))
@@ -562,3 +570,39 @@ def test_a_fast_turn_is_followed_through_the_poses_between():
     assert plan.coverage == 1.0
     assert verify(plan).ok
     assert plan_contacts(FLAT, guide, DT, GeneratorConfig(refine_stride=None)).last_valid_index == 0
+
+
+def test_retry_settings_name_only_step_settings():
+    """A retry may change how feet step, not how far the root may leave the guide
+    (what `verify` checks) nor what the stages are built from."""
+    retried = GeneratorConfig().retried((("lookahead", 0.9), ("max_candidates", 48)))
+    assert (retried.lookahead, retried.max_candidates, retried.retry_settings) == (0.9, 48, ())
+    for bad in ((("max_root_offset_xy", 0.2),), (("mu", 0.5),), ("lookahead",)):
+        with pytest.raises(ValueError, match="retry_settings"):
+            GeneratorConfig(retry_settings=(bad,))
+    with pytest.raises(ValueError, match="retry_backtrack"):
+        GeneratorConfig(retry_backtrack=-1)
+
+
+def test_a_stuck_plan_goes_back_and_retries_with_other_step_settings():
+    """A shipped-policy guide into the arena's stairs pit: with its own settings the
+    generator stops at guide pose 37, whatever it tries there; going back 4 planning poses
+    and planning them again with the other step settings of `retry_settings` in turn
+    places the feet so that pose 37 and the rest of the guide pass, within the root's usual
+    bounds (the plan verifies)."""
+    guide, timestep = _arena_guide("stairs_pit_retry")
+    assert plan_contacts(_arena(), guide, timestep, GeneratorConfig(retry_settings=())).last_valid_index == 37
+    plan = plan_contacts(_arena(), guide, timestep)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+
+
+def test_a_wider_step_search_finds_the_tread_a_foot_can_take():
+    """A shipped-policy guide climbing the arena's stairs: with candidates within 0.15 m of
+    the step target and a 0.25 m comfort region the plan stops at guide pose 63; the 0.30 m
+    candidate radius and 0.32 m comfort region (no retries needed) cover it."""
+    guide, timestep = _arena_guide("stairs_up_wide_search")
+    assert plan_contacts(_arena(), guide, timestep, _narrow()).last_valid_index == 63
+    plan = plan_contacts(_arena(), guide, timestep, GeneratorConfig(retry_settings=()))
+    assert plan.coverage == 1.0
+    assert verify(plan).ok

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from leas_jax.contacts.robot.database import DatabaseConfig
 from leas_jax.contacts.robot.model import FRICTION
@@ -48,7 +48,14 @@ class GeneratorConfig:
     # (test_the_foot_that_can_lead_steps_first_beside_a_void).
     # None: any step, the most lagging foot first.
     min_step_gain: float | None = 0.5
-    max_foot_offset: float = 0.25  # m, comfort region: sole to its nominal place in the root frame
+    # m, comfort region: sole to its nominal place in the root frame. A foot farther out
+    # steps; a foothold farther out is not a candidate. 0.25 m stopped guides on rubble and
+    # stairs where the one tile a foot could take lay 0.26-0.32 m out (with
+    # `candidate_radius` 0.30 and `max_candidates` 24: 70.7 -> 84.0 % of the shipped policy's
+    # arena guides, docs/results/2026-12-02-retry-settings). Leg IK, collisions and
+    # equilibrium bound every posture anyway; HPP's generator keeps a contact as long as
+    # its limb reaches it.
+    max_foot_offset: float = 0.32
     # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward
     max_foot_yaw: float = 0.5
     max_steps_per_pose: int = 2  # steps per planning pose (0.5 s at the default stride and timestep)
@@ -56,14 +63,14 @@ class GeneratorConfig:
         0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
     )
     # m, the same bound for a single-support posture, where the CoM must be over the stance
-    # sole. That sole may lie `max_foot_offset` (0.25 m) from its nominal place, itself 0.085 m
+    # sole. That sole may lie `max_foot_offset` (0.32 m) from its nominal place, itself 0.085 m
     # beside the root: with max_root_offset_xy the generator accepted feet it could not then
     # balance on (the most frequent reason its plans stopped on policy guides, 45 of 116 in
-    # docs/results/2026-12-02-arms-in). HPP's generator asks no balance of a one-contact
-    # state at all (hpp-rbprm ContactGenHelper, stableForOneContact = false by default); this
-    # one keeps it, quasi-static, with the root shifted this far
-    # (test_single_support_over_a_far_stance_sole).
-    max_single_support_offset_xy: float = 0.20
+    # docs/results/2026-12-02-arms-in; 0.20 m with a 0.25 m comfort region). HPP's generator
+    # asks no balance of a one-contact state at all (hpp-rbprm ContactGenHelper,
+    # stableForOneContact = false by default); this one keeps it, quasi-static, with the
+    # root shifted this far (test_single_support_over_a_far_stance_sole).
+    max_single_support_offset_xy: float = 0.25
     # m, where no stance under the guide's first pose passes every check, both soles' targets
     # are moved together this far in each of 8 root-frame directions (nearest first; the
     # first candidate of each foot), the root following within `max_root_offset_xy`. Beside a
@@ -83,10 +90,12 @@ class GeneratorConfig:
     min_knee: float = (
         0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
     )
-    candidate_radius: float = 0.15  # m, database samples this close to a step target are candidates
+    # m, database samples this close to a step target are candidates: on rubble the nearest
+    # tile a sole fits on lies up to 0.3 m from where the foot should go
+    candidate_radius: float = 0.30
     candidate_slab: float = 0.10  # m, samples this close (vertically) to a face are dropped on it
     candidate_grid: float = 0.01  # m, candidates closer than this are merged (one per cell)
-    max_candidates: int = 12  # candidates tried per step (in rank order)
+    max_candidates: int = 24  # candidates tried per step (in rank order)
     # On a beam (a face narrower than `beam_width` across one of its edges), a sole turned
     # by at most `beam_align_yaw` to the beam's axis is a candidate too, after the one at
     # the guide's yaw at the same place. eval_bridge's 0.30 m beam leaves 2 cm beside two
@@ -129,6 +138,23 @@ class GeneratorConfig:
     # rigid upper body.
     upper_bodies: tuple[str, ...] = ("half_sitting", "arms_in")
     database: DatabaseConfig = field(default_factory=DatabaseConfig)
+    # Where a planning pose cannot be reached, the generator goes back `retry_backtrack`
+    # planning poses and plans that stretch again with each of these alternative settings in
+    # turn (overrides of this config's fields, ((name, value), ...) each), then goes on with
+    # its own. The plan is greedy: a foot placed well for the next pose can leave the feet
+    # where a pose 1-2 s on fails, and which setting avoids it differs from guide to guide
+    # (farther-ahead steps before a climb, a longer root shift over a far stance sole on
+    # rubble); see docs/results/2026-12-02-retry-settings. Only the walking settings in
+    # RETRY_FIELDS may change. () never retries.
+    retry_settings: tuple = (
+        (("lookahead", 0.9),),
+        (("candidate_radius", 0.40), ("max_candidates", 48)),
+        (("max_foot_offset", 0.40),),
+        (("lookahead", 0.5),),
+        (("step_trigger", 0.05),),
+        (("swing_lift", 0.03),),
+    )
+    retry_backtrack: int = 4  # planning poses re-planned before the one that failed (2 s)
 
     def __post_init__(self):
         from leas_jax.contacts.robot.model import UPPER_BODY_POSTURES
@@ -145,6 +171,12 @@ class GeneratorConfig:
             raise ValueError(
                 f"GeneratorConfig.refine_stride must be None or an int >= 1, got {self.refine_stride!r}"
             )
+        if not (isinstance(self.retry_backtrack, int) and self.retry_backtrack >= 0):
+            raise ValueError(
+                f"GeneratorConfig.retry_backtrack must be an int >= 0, got {self.retry_backtrack!r}"
+            )
+        for overrides in self.retry_settings:
+            self.retried(overrides)
         _check_distances("stance_shifts", self.stance_shifts, "max_root_offset_xy", self.max_root_offset_xy)
         _check_distances(
             "arm_clearance_shifts",
@@ -152,6 +184,45 @@ class GeneratorConfig:
             "max_single_support_offset_xy",
             self.max_single_support_offset_xy,
         )
+
+    def retried(self, overrides) -> GeneratorConfig:
+        """This config with one entry of `retry_settings` applied (and no retries of its own).
+
+        Raises ValueError on a field outside RETRY_FIELDS or a malformed entry."""
+        try:
+            changes = dict(overrides)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"GeneratorConfig.retry_settings entries must be ((name, value), ...), got {overrides!r}"
+            ) from None
+        unknown = sorted(set(changes) - RETRY_FIELDS)
+        if unknown:
+            raise ValueError(
+                f"GeneratorConfig.retry_settings may change only {sorted(RETRY_FIELDS)}, got {unknown}"
+            )
+        return replace(self, retry_settings=(), **changes)
+
+
+# Settings the generator reads at each step (not when it builds its stages): what a retry
+# (`GeneratorConfig.retry_settings`) may change on the same stages. The root's bounds
+# (`max_root_offset_xy`, `max_single_support_offset_xy`, `max_root_offset_z`) are not among
+# them: they say how closely a plan follows its guide, which `contacts.verify` checks.
+RETRY_FIELDS = frozenset(
+    {
+        "lookahead",
+        "fallback_lookahead",
+        "step_trigger",
+        "step_trigger_yaw",
+        "min_step_gain",
+        "max_foot_offset",
+        "max_foot_yaw",
+        "max_steps_per_pose",
+        "candidate_radius",
+        "max_candidates",
+        "swing_lift",
+        "swing_clearance",
+    }
+)
 
 
 def _check_distances(name: str, values, bound_name: str, bound: float) -> None:

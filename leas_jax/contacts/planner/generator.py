@@ -114,11 +114,60 @@ class ContactGenerator:
             feet, first = start
             postures.append(first)
             last_valid = 0
+            passed = [(0, list(feet), 1)]  # (guide index, feet, postures so far) per planning pose
             for index in planning_indices(len(guide), cfg.stride):
                 last_valid = self._reach(guide, timestep, last_valid, index, feet, postures)
                 if last_valid != index:
+                    last_valid = self._retry(guide, timestep, index, passed, feet, postures, last_valid)
+                if last_valid != index:
                     break
+                passed.append((index, list(feet), len(postures)))
         return self._make_plan(guide, timestep, postures, last_valid)
+
+    def _retry(
+        self, guide, timestep, failed: int, passed: list, feet, postures: list, last_valid: int
+    ) -> int:
+        """Plan again to planning pose `failed` with each of `retry_settings` in turn, from
+        `retry_backtrack` planning poses before it (`passed` holds (guide index, feet,
+        postures so far) at each planning pose reached; mutates it, `feet` and `postures`).
+
+        Returns `failed` where a setting passes it (`passed` then ends at the pose before),
+        else `last_valid`, with `feet`, `postures` and the rejection counts as the
+        generator's own settings left them."""
+        cfg = self.config
+        keep = max(len(passed) - 1 - cfg.retry_backtrack, 0)
+        indices = [index for index, _, _ in passed[keep + 1 :]] + [failed]
+        own = (list(feet), list(postures), self._rejections_copy())
+        for overrides in cfg.retry_settings:
+            start, start_feet, count = passed[keep]
+            feet[:] = start_feet
+            del postures[count:]
+            reached, at = [], start
+            self._set_stage_config(cfg.retried(overrides))
+            try:
+                for index in indices:
+                    at = self._reach(guide, timestep, at, index, feet, postures)
+                    if at != index:
+                        break
+                    reached.append((index, list(feet), len(postures)))
+            finally:
+                self._set_stage_config(cfg)
+            if at == failed:
+                passed[keep + 1 :] = reached[:-1]
+                return failed
+        feet[:], postures[:] = own[0], own[1]
+        if own[2] is not None:
+            self.projection.rejections.clear()
+            self.projection.rejections.update(own[2])
+        return last_valid
+
+    def _set_stage_config(self, config: GeneratorConfig) -> None:
+        """The settings every stage reads from now on (see `GeneratorConfig.retried`)."""
+        self.projection.config = self.footholds.config = self.walking.config = config
+
+    def _rejections_copy(self) -> Counter | None:
+        rejections = self.projection.rejections
+        return None if rejections is None else Counter(rejections)
 
     def _reach(self, guide, timestep, last_valid: int, index: int, feet, postures: list) -> int:
         """Plan from guide pose `last_valid` to planning pose `index`, appending to `postures`

@@ -42,6 +42,16 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
 PYTHONPATH=$PWD python benchmarks/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
   --variants rblin,rbkino --sweep-steps ""
 
+#    The shipped policy's eval_ground speed and arena safety (10 s).
+leas arena-check --checkpoint checkpoints/leas_talos --out $D/arena_check_shipped
+
 # 4. The learned condition relabelled on this generator's walking truth (labels cached in
 #    .cache/, 24 000 poses), fitted and validated; writes checkpoints/feasibility/walking.npz.
 PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/feasibility
+
+# 5. `make run` from a fresh clone of this commit (outside the repository, here /tmp/mr), then
+#    its planner-phase policy's own arena guides on two evaluation seeds:
+#      git clone . /tmp/mr && (cd /tmp/mr && time make run)
+#      for S in 0 1; do PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy /tmp/mr/runs/quick/planner \
+#        --starts 256 --workers 2 --spawns condition --seed $S --out $D/make_run/guides_seed$S; done
+#    and runs/quick/report.md with its figures copied into $D/make_run/.

@@ -55,3 +55,13 @@ PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/
 #      for S in 0 1; do PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy /tmp/mr/runs/quick/planner \
 #        --starts 256 --workers 2 --spawns condition --seed $S --out $D/make_run/guides_seed$S; done
 #    and runs/quick/report.md with its figures copied into $D/make_run/.
+
+# 6. The ablation's geometric policies (docs/results/2026-12-02-ablation, 3 seeds each of
+#    cylinders and the learned condition) judged by this generator, 2 evaluation seeds: the
+#    finished runs are copied and reused, not retrained (10 min). The learned runs terminate
+#    their episodes with the weights at their stored path, i.e. step 4's relabelled ones.
+rm -rf /tmp/study && mkdir -p /tmp/study/runs
+cp -r docs/results/2026-12-02-ablation/study/runs/cylinders docs/results/2026-12-02-ablation/study/runs/learned /tmp/study/runs/
+PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out /tmp/study --methods cylinders,learned \
+  --seeds 0,1,2 --eval-seeds 0,1 --starts 256 --workers 2
+mkdir -p $D/study && cp /tmp/study/feasibility_study.json /tmp/study/feasibility_study.md /tmp/study/feasibility_study.png $D/study/

@@ -65,3 +65,8 @@ cp -r docs/results/2026-12-02-ablation/study/runs/cylinders docs/results/2026-12
 PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out /tmp/study --methods cylinders,learned \
   --seeds 0,1,2 --eval-seeds 0,1 --starts 256 --workers 2
 mkdir -p $D/study && cp /tmp/study/feasibility_study.json /tmp/study/feasibility_study.md /tmp/study/feasibility_study.png $D/study/
+
+# 7. Planner-in-the-loop throughput on the idle machine, 12 iterations of 64 episodes from the
+#    shipped pretrain, 2 contact workers (3 min).
+PYTHONPATH=$PWD python benchmarks/planner_training_throughput.py --init checkpoints/leas_talos/pretrain \
+  --workers 2 --iterations 12 --out $D/planner_throughput

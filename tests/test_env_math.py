@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from leas_jax.env import EnvConfig, heightfield_from_raster, heightmap, kinematics, reachability, reward
-from leas_jax.env.field import disk_filter, sample_bilinear, sample_nearest
+from leas_jax.env.field import disk_filter, sample_bilinear, sample_bilinear_xy, sample_nearest, sample_nearest_xy
 
 RES = 0.02
 CFG = EnvConfig()
@@ -214,6 +214,25 @@ def test_nearest_sampling_of_rasters():
     field = field_of(heights, require_spawn=False)  # 1 m wide: the hands and lookahead reach past it
     assert float(sample_nearest(field, field.heights, jnp.array([0.505, 0.495]))) == 1.0
     assert float(sample_nearest(field, field.heights, jnp.array([-0.5, 0.5]))) == -2.0
+
+
+def test_world_xy_and_the_column_samplers_agree_with_the_stacked_forms():
+    rng = np.random.default_rng(1)
+    n = 101
+    heights = rng.uniform(-0.5, 0.5, (n, n)).astype(np.float32)
+    field = field_of(heights, require_spawn=False)
+    offsets = jnp.asarray(rng.uniform(-0.6, 0.6, (40, 2)), jnp.float32)
+    for p in (pose(1.0, 1.2, 0.9, 0.7), pose(0.1, 1.9, 0.9, -2.5)):  # the second reaches past the grid
+        x, y = kinematics.world_xy(p, offsets)
+        stacked = p[:2] + kinematics.rotate_z(offsets, p[3])
+        np.testing.assert_allclose(np.stack([x, y], -1), stacked, atol=1e-6)
+        assert x.shape == y.shape == (40,)
+        np.testing.assert_array_equal(
+            sample_nearest_xy(field, field.heights, x, y, outside=7.0),
+            sample_nearest(field, field.heights, stacked, outside=7.0),
+        )
+        np.testing.assert_allclose(sample_bilinear_xy(field, x, y), sample_bilinear(field, stacked), atol=1e-6)
+    assert bool(jnp.any(sample_nearest_xy(field, field.heights, x, y, outside=7.0) == 7.0))
 
 
 # -- reward ------------------------------------------------------------------

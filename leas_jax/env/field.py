@@ -66,10 +66,10 @@ class Heightfield:
     condition: dict = struct.field(default_factory=dict)
 
 
-def _grid_index(field: Heightfield, xy: jax.Array):
-    """Continuous grid coordinates of world points. xy: [..., 2] -> ([...], [...])."""
-    u = (xy[..., 0] - field.origin[0]) / field.resolution
-    v = (xy[..., 1] - field.origin[1]) / field.resolution
+def _grid_index(field: Heightfield, x: jax.Array, y: jax.Array):
+    """Continuous grid coordinates of world points. x, y: [...] -> ([...], [...])."""
+    u = (x - field.origin[0]) / field.resolution
+    v = (y - field.origin[1]) / field.resolution
     return u, v
 
 
@@ -85,8 +85,17 @@ def sample_nearest(field: Heightfield, raster: jax.Array, xy: jax.Array, outside
     Returns:
         [...] raster values.
     """
+    return sample_nearest_xy(field, raster, xy[..., 0], xy[..., 1], outside)
+
+
+def sample_nearest_xy(field: Heightfield, raster: jax.Array, x: jax.Array, y: jax.Array, outside=None):
+    """`sample_nearest` of the world points (x, y), x and y: [...] each -> [...] raster values.
+
+    Many points per pose sample faster given as two arrays (`kinematics.world_xy`) than as
+    one [..., 2] array.
+    """
     nx, ny = raster.shape
-    u, v = _grid_index(field, xy)
+    u, v = _grid_index(field, x, y)
     i = jnp.round(u).astype(jnp.int32)
     j = jnp.round(v).astype(jnp.int32)
     inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
@@ -106,9 +115,14 @@ def sample_bilinear(field: Heightfield, xy: jax.Array) -> jax.Array:
     Returns:
         [...] heights (m).
     """
+    return sample_bilinear_xy(field, xy[..., 0], xy[..., 1])
+
+
+def sample_bilinear_xy(field: Heightfield, x: jax.Array, y: jax.Array) -> jax.Array:
+    """`sample_bilinear` of the world points (x, y), x and y: [...] each -> [...] heights (m)."""
     heights = field.heights
     nx, ny = heights.shape
-    u, v = _grid_index(field, xy)
+    u, v = _grid_index(field, x, y)
     inside = (u >= 0) & (u <= nx - 1) & (v >= 0) & (v <= ny - 1)
     i0 = jnp.clip(jnp.floor(u).astype(jnp.int32), 0, nx - 2)
     j0 = jnp.clip(jnp.floor(v).astype(jnp.int32), 0, ny - 2)

@@ -5,8 +5,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from leas_jax.env.config import HeightmapConfig
-from leas_jax.env.field import Heightfield, sample_bilinear
-from leas_jax.env.kinematics import rotate_z
+from leas_jax.env.field import Heightfield, sample_bilinear_xy
+from leas_jax.env.kinematics import rotate_z, world_xy
 
 
 def grid_offsets(config: HeightmapConfig = HeightmapConfig()) -> np.ndarray:
@@ -43,5 +43,5 @@ def sample(field: Heightfield, pose: jax.Array, config: HeightmapConfig = Height
     Returns:
         [77] relative heights (m) in [clip_low, clip_high], row-major as `grid_offsets`.
     """
-    heights = sample_bilinear(field, sample_points(pose, config))
+    heights = sample_bilinear_xy(field, *world_xy(pose, jnp.asarray(grid_offsets(config))))
     return jnp.clip(heights - pose[2], config.clip_low, config.clip_high)

@@ -32,8 +32,8 @@ import numpy as np
 
 from leas_jax.env import reachability
 from leas_jax.env.config import ReachabilityConfig
-from leas_jax.env.field import Heightfield, sample_nearest
-from leas_jax.env.kinematics import rotate_z
+from leas_jax.env.field import Heightfield, sample_nearest_xy
+from leas_jax.env.kinematics import world_xy
 from leas_jax.env.learned_weights import (  # noqa: F401 (the weights' file API, re-exported)
     LAYER_KEYS,
     LearnedParams,
@@ -109,8 +109,8 @@ def raw_features(
         [P + 1 + M]: terrain height minus z at the patch points (clipped), z minus the
         local ground (clipped to HEIGHT_CLIP), the M `reachability.margins`.
     """
-    points = pose[:2] + rotate_z(grid, pose[3])
-    relative = sample_nearest(field, field.heights, points) - pose[2]
+    x, y = world_xy(pose, grid)
+    relative = sample_nearest_xy(field, field.heights, x, y) - pose[2]
     near = jnp.sum(grid**2, axis=-1) <= GROUND_RADIUS**2
     above_ground = -jnp.max(jnp.where(near, relative, -jnp.inf))
     return jnp.concatenate(

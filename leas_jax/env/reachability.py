@@ -41,8 +41,8 @@ import jax
 import jax.numpy as jnp
 
 from leas_jax.env.config import ReachabilityConfig
-from leas_jax.env.field import Heightfield, sample_nearest
-from leas_jax.env.kinematics import rotate_z
+from leas_jax.env.field import Heightfield, sample_nearest, sample_nearest_xy
+from leas_jax.env.kinematics import rotate_z, world_xy
 
 
 def leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
@@ -55,17 +55,27 @@ def all_leg_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityCo
     the root frame, [2, 2] (left, right), then at (leg_forward, ±leg_lateral_offset) when the
     lookahead is enabled (`leg_forward` != 0): [4, 2] (left, right, left ahead, right ahead).
     pose: [4] (x, y, z, yaw), world."""
+    return jnp.stack(_leg_xy(pose, config), axis=-1)
+
+
+def _leg_xy(pose: jax.Array, config: ReachabilityConfig) -> tuple[jax.Array, jax.Array]:
+    """`all_leg_centers` as two arrays, x [L] and y [L] (`kinematics.world_xy`)."""
     forwards = (0.0,) if config.leg_forward == 0.0 else (0.0, config.leg_forward)
     offsets = jnp.array([[x, side * config.leg_lateral_offset] for x in forwards for side in (1.0, -1.0)])
-    return pose[:2] + rotate_z(offsets, pose[3])
+    return world_xy(pose, offsets)
 
 
 def hand_centers(pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()) -> jax.Array:
     """World (x, y) of the hand disks, [2, 2] (left, right). pose: [4] (x, y, z, yaw), world."""
+    return jnp.stack(_hand_xy(pose, config), axis=-1)
+
+
+def _hand_xy(pose: jax.Array, config: ReachabilityConfig) -> tuple[jax.Array, jax.Array]:
+    """`hand_centers` as two arrays, x [2] and y [2] (`kinematics.world_xy`)."""
     offsets = jnp.array(
         [[config.hand_forward, config.hand_lateral], [config.hand_forward, -config.hand_lateral]]
     )
-    return pose[:2] + rotate_z(offsets, pose[3])
+    return world_xy(pose, offsets)
 
 
 def _term_raster(field: Heightfield, raster: jax.Array, term: str) -> jax.Array:
@@ -94,17 +104,17 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
     """
     z = pose[2]
     trunk_free = sample_nearest(field, field.trunk_max, pose[:2]) < z + config.trunk_bottom
-    legs = all_leg_centers(pose, config)  # [L, 2], L = 2 or 4
-    highest = sample_nearest(field, field.leg_max, legs, outside=-jnp.inf)
-    lowest = sample_nearest(field, field.leg_min, legs, outside=jnp.inf)
+    legs = _leg_xy(pose, config)  # x [L], y [L]; L = 2 or 4
+    highest = sample_nearest_xy(field, field.leg_max, *legs, outside=-jnp.inf)
+    lowest = sample_nearest_xy(field, field.leg_min, *legs, outside=jnp.inf)
     touch = (highest >= z + config.leg_bottom) & (lowest <= z + config.leg_top)  # [L]
     yes = jnp.array(True)
-    ahead = (touch[2], touch[3]) if len(legs) == 4 else (yes, yes)
+    ahead = (touch[2], touch[3]) if len(touch) == 4 else (yes, yes)
     if config.foothold_spread is None:
         foothold = (yes, yes)
     else:
         flat = (
-            sample_nearest(field, _term_raster(field, field.foothold, "foothold"), legs, outside=jnp.inf)
+            sample_nearest_xy(field, _term_raster(field, field.foothold, "foothold"), *legs, outside=jnp.inf)
             <= config.foothold_spread
         )
         flat = flat.reshape(-1, 2).all(axis=0)  # [2]: left, right (over the leg and its lookahead leg)
@@ -113,10 +123,10 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
         hands = (yes, yes)
     else:
         free = (
-            sample_nearest(
+            sample_nearest_xy(
                 field,
                 _term_raster(field, field.hand_max, "hand"),
-                hand_centers(pose, config),
+                *_hand_xy(pose, config),
                 outside=-jnp.inf,
             )
             < z + config.hand_bottom
@@ -158,19 +168,19 @@ def margins(
     foothold, >= 0.
     """
     z = pose[2]
-    legs = all_leg_centers(pose, config)
+    legs = _leg_xy(pose, config)
     parts = [
         (z + config.trunk_bottom - sample_nearest(field, field.trunk_max, pose[:2]))[None],
-        sample_nearest(field, field.leg_max, legs, outside=-jnp.inf) - (z + config.leg_bottom),
-        (z + config.leg_top) - sample_nearest(field, field.leg_min, legs, outside=jnp.inf),
+        sample_nearest_xy(field, field.leg_max, *legs, outside=-jnp.inf) - (z + config.leg_bottom),
+        (z + config.leg_top) - sample_nearest_xy(field, field.leg_min, *legs, outside=jnp.inf),
     ]
     if config.foothold_spread is not None:
         foothold = _term_raster(field, field.foothold, "foothold")
-        parts.append(config.foothold_spread - sample_nearest(field, foothold, legs, outside=jnp.inf))
+        parts.append(config.foothold_spread - sample_nearest_xy(field, foothold, *legs, outside=jnp.inf))
     if config.hand_radius is not None:
         hand = _term_raster(field, field.hand_max, "hand")
         parts.append(
-            z + config.hand_bottom - sample_nearest(field, hand, hand_centers(pose, config), outside=-jnp.inf)
+            z + config.hand_bottom - sample_nearest_xy(field, hand, *_hand_xy(pose, config), outside=-jnp.inf)
         )
     return jnp.clip(jnp.concatenate(parts), -MARGIN_CLIP, MARGIN_CLIP)
 

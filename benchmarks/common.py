@@ -14,6 +14,7 @@ import math
 import os
 import platform
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -97,13 +98,19 @@ def machine() -> dict:
 def provenance(load_before: dict) -> dict:
     """What every benchmark record carries: the time, the machine, the git state when the
     benchmark started, and the load average before (`load_before`) and after (now)."""
-    return {
+    record = {
         "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         "machine": machine(),
         "git": GIT_AT_START,
         "load_average_before": load_before,
         "load_average_after": load_average(),
     }
+    package = sys.modules.get("leas_jax")
+    if package is not None and package.__file__:
+        # the code measured: another checkout's package when PYTHONPATH points there
+        root = Path(package.__file__).resolve().parent.parent
+        record["leas_jax"] = {"path": str(root), **git_state(root)}
+    return record
 
 
 def add_out_argument(parser: argparse.ArgumentParser) -> None:

@@ -20,7 +20,7 @@ median over repeats), which the machine's load moves much less than steps/s; and
 per CPU-second of the process (all its threads), with its ratio to the reference's.
 Writes <out>/env_throughput.json.
 
-    python benchmarks/env_throughput.py [--envs 256,1024,8192] [--steps 200] [--repeats 3] [--preset quick]
+    python benchmarks/env_throughput.py [--envs 256,1024,8192] [--steps 200] [--repeats 3] [--preset quick] [--condition learned]
 """
 
 from __future__ import annotations
@@ -158,7 +158,7 @@ def measure(field, config, num_envs: int, steps: int, repeats: int) -> dict:
 def main(argv=None) -> None:
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import preset, resolve_data_path
+    from leas_jax.training.config import learned_condition_env, preset, resolve_data_path
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--terrain", default="terrains/training_arena.toml")
@@ -168,9 +168,18 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--preset", default=None, help="the env configuration of this training preset (default: EnvConfig())"
     )
+    parser.add_argument(
+        "--condition",
+        choices=("cylinders", "learned"),
+        default="cylinders",
+        help="termination condition: the configuration's cylinders or the learned network "
+        "(`learned_condition_env`, the shipped weights)",
+    )
     add_out_argument(parser)
     args = parser.parse_args(argv)
     config = EnvConfig() if args.preset is None else preset(args.preset).env
+    if args.condition == "learned":
+        config = learned_condition_env(config)
     field = heightfield_from_terrain(load_terrain(resolve_data_path(args.terrain)), config)
     load_before = load_average()
     rows = []
@@ -197,6 +206,7 @@ def main(argv=None) -> None:
         {
             "terrain": args.terrain,
             "env_config": "EnvConfig()" if args.preset is None else f"preset({args.preset!r}).env",
+            "condition": args.condition,
             "programs": {
                 "reference": "benchmarks/reference_env.py, jax.vmap",
                 "plain_vmap": "jax.vmap(LeasEnv.reset), jax.vmap(LeasEnv.step), no auto-reset",

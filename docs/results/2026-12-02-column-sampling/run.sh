@@ -1,0 +1,31 @@
+#!/bin/sh
+# Env and training throughput before and after the samplers took separate x and y arrays
+# (kinematics.world_xy, field.sample_nearest_xy / sample_bilinear_xy), measured in the same
+# run, alternating, two rounds: the `paper` and `quick` presets with the cylinders and the
+# learned condition. The benchmark scripts are this commit's; PYTHONPATH picks the package
+# measured (each JSON's "leas_jax" records its checkout and commit). Run from the repository
+# root with the environment installed (`make venv`); 2 cores, nothing else running (25 min).
+set -e
+export PATH="$PWD/.venv/bin:$PATH"
+D=docs/results/2026-12-02-column-sampling
+BEFORE=f09e9c1
+AFTER=${AFTER:-HEAD}
+rm -rf /tmp/cs_before /tmp/cs_after
+git worktree add --detach /tmp/cs_before $BEFORE
+git worktree add --detach /tmp/cs_after $AFTER
+for ROUND in 1 2; do
+  for SIDE in before after; do
+    P=/tmp/cs_$SIDE
+    O=$D/$SIDE/round$ROUND
+    for C in cylinders learned; do
+      PYTHONPATH=$P python benchmarks/env_throughput.py --preset paper --envs 2048 --repeats 3 \
+        --condition $C --out $O/env_$C
+    done
+    PYTHONPATH=$P python benchmarks/train_throughput.py --presets paper,quick --conditions cylinders,learned \
+      --calls 3 --out $O
+  done
+done
+git worktree remove --force /tmp/cs_before
+git worktree remove --force /tmp/cs_after
+python $D/summarise.py $D > $D/summary.md
+cat $D/summary.md

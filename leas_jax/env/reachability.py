@@ -182,7 +182,9 @@ def margins(
         parts.append(
             z + config.hand_bottom - sample_nearest_xy(field, hand, *_hand_xy(pose, config), outside=-jnp.inf)
         )
-    return jnp.clip(jnp.concatenate(parts), -MARGIN_CLIP, MARGIN_CLIP)
+    # each part clipped before the concatenation: vmapped, clipping the concatenated [B, M]
+    # array instead made XLA:CPU take 0.75 us per pose against 0.09 us (2 cores)
+    return jnp.concatenate([jnp.clip(part, -MARGIN_CLIP, MARGIN_CLIP) for part in parts])
 
 
 def shifted_poses(pose: jax.Array, margin: float) -> jax.Array:

@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 
 from leas_jax.env import EnvConfig, heightfield_from_raster, heightmap, kinematics, reachability, reward
-from leas_jax.env.field import disk_filter, sample_bilinear, sample_bilinear_xy, sample_nearest, sample_nearest_xy
+from leas_jax.env.field import (
+    disk_filter,
+    sample_bilinear,
+    sample_bilinear_xy,
+    sample_nearest,
+    sample_nearest_xy,
+)
 
 RES = 0.02
 CFG = EnvConfig()
@@ -231,7 +237,9 @@ def test_world_xy_and_the_column_samplers_agree_with_the_stacked_forms():
             sample_nearest_xy(field, field.heights, x, y, outside=7.0),
             sample_nearest(field, field.heights, stacked, outside=7.0),
         )
-        np.testing.assert_allclose(sample_bilinear_xy(field, x, y), sample_bilinear(field, stacked), atol=1e-6)
+        np.testing.assert_allclose(
+            sample_bilinear_xy(field, x, y), sample_bilinear(field, stacked), atol=1e-6
+        )
     assert bool(jnp.any(sample_nearest_xy(field, field.heights, x, y, outside=7.0) == 7.0))
 
 

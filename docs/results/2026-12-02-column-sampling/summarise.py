@@ -39,24 +39,28 @@ def figures(folder: Path) -> dict:
 
 def main(folder: Path) -> None:
     rows = figures(folder)
-    print("| what | preset | condition | before: steps/s (/ reference) per round | after: the same "
-          "| after / before per round (steps/s) | the same (ratios to the reference) |")
+    print(
+        "| what | preset | condition | before: steps/s (/ reference) per round | after: the same "
+        "| after / before per round (steps/s) | the same (ratios to the reference) |"
+    )
     print("|---|---|---|---|---|---|---|")
     for (what, name, condition), sides in rows.items():
         cells = [", ".join(f"{s:,.0f} ({r:.3f})" for s, r in sides[side]) for side in SIDES]
         pairs = list(zip(sides["after"], sides["before"], strict=True))
         gains = [a / b for (a, _), (b, _) in pairs]
         relative = [a / b for (_, a), (_, b) in pairs]
-        print(f"| {what} | {name} | {condition} | {cells[0]} | {cells[1]} | "
-              f"{', '.join(f'x {g:.2f}' for g in gains)} (mean x {statistics.mean(gains):.2f}) | "
-              f"{', '.join(f'x {g:.2f}' for g in relative)} (mean x {statistics.mean(relative):.2f}) |")
+        print(
+            f"| {what} | {name} | {condition} | {cells[0]} | {cells[1]} | "
+            f"{', '.join(f'x {g:.2f}' for g in gains)} (mean x {statistics.mean(gains):.2f}) | "
+            f"{', '.join(f'x {g:.2f}' for g in relative)} (mean x {statistics.mean(relative):.2f}) |"
+        )
     print()
     print("| what | preset | side | learned / cylinders time per env step, per round |")
     print("|---|---|---|---|")
     for what, name in sorted({(w, p) for w, p, _ in rows}):
         for side in SIDES:
             cyl, learned = rows[(what, name, "cylinders")][side], rows[(what, name, "learned")][side]
-            costs = [c / l for (c, _), (l, _) in zip(cyl, learned, strict=True)]
+            costs = [c / n for (c, _), (n, _) in zip(cyl, learned, strict=True)]
             print(f"| {what} | {name} | {side} | {', '.join(f'x {c:.2f}' for c in costs)} |")
 
 

@@ -6,7 +6,7 @@ import numpy as np
 
 from leas_jax.env.config import HeightmapConfig
 from leas_jax.env.field import Heightfield, sample_bilinear_xy
-from leas_jax.env.kinematics import rotate_z, world_xy
+from leas_jax.env.kinematics import world_xy
 
 
 def grid_offsets(config: HeightmapConfig = HeightmapConfig()) -> np.ndarray:
@@ -24,12 +24,6 @@ def grid_offsets(config: HeightmapConfig = HeightmapConfig()) -> np.ndarray:
     ys = config.lateral_step * np.arange(-config.lateral_half_count, config.lateral_half_count + 1)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     return np.stack([gx.ravel(), gy.ravel()], axis=-1).astype(np.float32)
-
-
-def sample_points(pose: jax.Array, config: HeightmapConfig = HeightmapConfig()) -> jax.Array:
-    """World (x, y) of the heightmap points. pose: [4] (x, y, z, yaw) -> [77, 2]."""
-    offsets = jnp.asarray(grid_offsets(config))
-    return pose[:2] + rotate_z(offsets, pose[3])
 
 
 def sample(field: Heightfield, pose: jax.Array, config: HeightmapConfig = HeightmapConfig()) -> jax.Array:

@@ -14,7 +14,12 @@ Variants (`--variants`):
   rbkino           RBKino with HPP's fixed-time synchronisation (the default);
   rbkino_cruise    RBKino with the former synchronisation (+-a_max, lower cruise
                    velocity: a start velocity across the goal dies within 0.1 s);
-  rbkino_vmax030   RBKino with hpp-rbprm-corba's Talos vMax = 0.30 m/s.
+  rbkino_vmax030   RBKino with hpp-rbprm-corba's Talos vMax = 0.30 m/s;
+  rbkino_dt001     RBKino's continuous path sampled every 0.01 s, as HPP's contact
+                   generator samples it (hpp-rbprm-corba scenarios/
+                   abstract_contact_generator.py, `interpolate(0.01, ...)`), judged by a
+                   generator planning at the same 0.5 s as the others (its refinement,
+                   `GeneratorConfig.refine_stride`, then steps through the 0.01 s poses).
 
 and two diagnostics of the generator's turning:
 
@@ -63,6 +68,7 @@ VARIANTS = {
     "rbkino": ("rbkino", {}),
     "rbkino_cruise": ("rbkino", {"rbkino_sync": "cruise"}),
     "rbkino_vmax030": ("rbkino", {"v_max": 0.30}),
+    "rbkino_dt001": ("rbkino", {"timestep": 0.01}),
 }
 BOOTSTRAP = 2000  # resamples of the mean-coverage interval
 FIRST_PLANNING_POSE = 5  # guide index of the generator's first planning pose (GeneratorConfig.stride)
@@ -83,15 +89,15 @@ def bootstrap_mean(values: np.ndarray, seed: int = 0) -> tuple[float, float]:
     return float(np.percentile(means, 2.5)), float(np.percentile(means, 97.5))
 
 
-def first_turn_deg(guide: np.ndarray) -> float:
-    """|yaw change| (deg) from the first guide pose to the generator's first planning pose."""
-    k = min(FIRST_PLANNING_POSE, len(guide) - 1)
+def first_turn_deg(guide: np.ndarray, poses: int = FIRST_PLANNING_POSE) -> float:
+    """|yaw change| (deg) from the first guide pose to the generator's first planning pose (`poses` on)."""
+    k = min(poses, len(guide) - 1)
     return float(abs(math.degrees(guide[k, 3] - guide[0, 3])))
 
 
-def max_turn_deg(guide: np.ndarray) -> float:
-    """Largest |yaw change| (deg) over any FIRST_PLANNING_POSE consecutive steps (0.5 s) of the guide."""
-    k = min(FIRST_PLANNING_POSE, len(guide) - 1)
+def max_turn_deg(guide: np.ndarray, poses: int = FIRST_PLANNING_POSE) -> float:
+    """Largest |yaw change| (deg) over any `poses` consecutive steps (0.5 s at 0.1 s) of the guide."""
+    k = min(poses, len(guide) - 1)
     return float(np.degrees(np.abs(guide[k:, 3] - guide[: len(guide) - k, 3])).max()) if k else 0.0
 
 
@@ -171,14 +177,33 @@ def build(jobs, terrain, field, cells, n_starts: int, base, env):
 
 def judge(terrain, trajectories, timestep: float, workers: int, stride: int | None) -> None:
     """Fill every trajectory's outcome with `evaluate.validate`: the generator's defaults
-    (stride None), else a generator that plans every `stride`-th guide pose."""
+    (stride None), else a generator that plans every `stride`-th guide pose. Guides sampled
+    at a finer timestep than `timestep` (a variant's `timestep` override) are judged at
+    their own, with the stride that keeps the generator's planning interval in seconds."""
     from leas_jax.contacts import GeneratorConfig
     from leas_jax.eval.evaluate import validate
 
-    config = None if stride is None else GeneratorConfig(stride=stride)
-    validate(
-        terrain, trajectories, timestep, workers, progress=True, desc="table II baselines", config=config
-    )
+    groups: dict[float, list] = {}
+    for t in trajectories:
+        groups.setdefault(variant_timestep(t.method, timestep), []).append(t)
+    for dt, group in groups.items():
+        poses = stride if stride is not None else GeneratorConfig().stride
+        config = (
+            None
+            if stride is None and dt == timestep
+            else GeneratorConfig(stride=planning_stride(poses, timestep, dt))
+        )
+        validate(terrain, group, dt, workers, progress=True, desc="table II baselines", config=config)
+
+
+def variant_timestep(label: str, timestep: float) -> float:
+    """s between the guide poses of a trajectory labelled `label`: its variant's override, else `timestep`."""
+    return VARIANTS.get(label, ("", {}))[1].get("timestep", timestep)
+
+
+def planning_stride(stride: int, timestep: float, finer: float) -> int:
+    """Guide poses per planning pose at timestep `finer` for the planning interval of `stride` poses at `timestep`."""
+    return max(1, int(round(stride * timestep / finer)))
 
 
 def figure(report: dict, path: Path) -> None:
@@ -237,8 +262,22 @@ def figure(report: dict, path: Path) -> None:
             ax.axvline(gap["failed_min"], color="k", lw=0.8, ls=":")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    ax = axes[len(table) + 1]
+    sweep_panel(axes[len(table) + 1], report)
+    fig.tight_layout()
+    import io
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110)
+    plt.close(fig)
+    atomic_write_bytes(path, buffer.getvalue())
+
+
+def sweep_panel(ax, report: dict) -> None:
+    """RBLin's coverage against its in-place turn rate (the `--sweep-steps` cells); blank without a sweep."""
     sweep = report.get("rblin_sweep", {})
+    if not sweep:
+        ax.axis("off")
+        return
     for v in sorted({row["speed"] for row in sweep.values()}):
         rows = sorted((row for row in sweep.values() if row["speed"] == v), key=lambda r: r["deg_per_s"])
         x = [r["deg_per_s"] for r in rows]
@@ -258,13 +297,6 @@ def figure(report: dict, path: Path) -> None:
     ax.set_title("turning in place")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    import io
-
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
-    atomic_write_bytes(path, buffer.getvalue())
 
 
 def main(argv=None) -> None:
@@ -331,6 +363,7 @@ def main(argv=None) -> None:
         "rbkino": "RBKino, HPP synchronisation (default)",
         "rbkino_cruise": "RBKino, former synchronisation (+-a_max)",
         "rbkino_vmax030": "RBKino, HPP Talos vMax 0.30 m/s",
+        "rbkino_dt001": "RBKino, sampled every 0.01 s as HPP's generator",
     }
     described = {
         v: {"method": VARIANTS[v][0], "overrides": VARIANTS[v][1], "title": titles[v]} for v in variants
@@ -379,6 +412,10 @@ def main(argv=None) -> None:
             row.update(rotation_steps=base.rotation_steps, speed=cells[k].speed[0])
             row["deg_per_s"] = 180.0 / (base.rotation_steps * base.timestep)
             report["rblin_sweep"][f"{base.rotation_steps} steps, {cells[k].name}"] = row
+
+    def half_second(label):  # guide poses in the generator's first planning interval
+        return planning_stride(FIRST_PLANNING_POSE, base.timestep, variant_timestep(label, base.timestep))
+
     report["trajectories"] = [
         {
             "variant": t.method,
@@ -389,8 +426,9 @@ def main(argv=None) -> None:
             "success": t.outcome.success,
             "last_valid_index": t.outcome.last_valid_index,
             "guide_poses": len(t.guide),
-            "first_turn_deg": first_turn_deg(t.guide),
-            "max_turn_deg": max_turn_deg(t.guide),
+            "timestep": variant_timestep(t.method, base.timestep),
+            "first_turn_deg": first_turn_deg(t.guide, half_second(t.method)),
+            "max_turn_deg": max_turn_deg(t.guide, half_second(t.method)),
             "error": t.outcome.error,
         }
         for t in trajectories

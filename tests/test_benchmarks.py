@@ -187,3 +187,30 @@ def test_guide_failures_compare_pairs_the_same_episodes(tmp_path):
         guide_failures.main(
             ["--compare", str(tmp_path / "missing.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
         )
+
+
+def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
+    """RBKino from a start turned 60-120 degrees from the target at 0.01 m/s turns its root
+    30-75 degrees between two poses 0.1 s apart: the generator stops at its first pose.
+    Sampled every 0.01 s, as HPP's contact generator samples the path, and judged at the
+    same 0.5 s planning interval, it is followed to the goal."""
+    import table2_baselines as table2
+
+    from leas_jax.eval.scenarios import cells_for, scenario_file
+    from leas_jax.steering.baselines import BaselineConfig
+
+    assert table2.planning_stride(5, 0.1, 0.01) == 50 and table2.planning_stride(5, 0.1, 0.1) == 5
+    assert table2.variant_timestep("rbkino_dt001", 0.1) == 0.01
+    assert table2.variant_timestep("rbkino", 0.1) == 0.1
+    terrain = load_terrain(scenario_file("ground"))
+    env = EnvConfig()
+    base = BaselineConfig.from_env(env)
+    field = heightfield_from_terrain(terrain, env)
+    cells = cells_for("ground", terrain.scenario)
+    turned = next(k for k, c in enumerate(cells) if c.yaw_deg == (60.0, 120.0) and c.speed[0] == 0.01)
+    jobs = [(v, "rbkino", table2.VARIANTS[v][1], [turned]) for v in ("rbkino", "rbkino_dt001")]
+    coarse, fine = table2.build(jobs, terrain, field, cells, 1, base, env)
+    assert len(fine.guide) > 9 * len(coarse.guide)
+    table2.judge(terrain, [coarse, fine], base.timestep, 0, None)
+    assert coarse.outcome.last_valid_index == 0
+    assert fine.outcome.coverage == 1.0 and fine.outcome.success

@@ -177,22 +177,19 @@ def build(jobs, terrain, field, cells, n_starts: int, base, env):
 
 def judge(terrain, trajectories, timestep: float, workers: int, stride: int | None) -> None:
     """Fill every trajectory's outcome with `evaluate.validate`: the generator's defaults
-    (stride None), else a generator that plans every `stride`-th guide pose. Guides sampled
-    at a finer timestep than `timestep` (a variant's `timestep` override) are judged at
-    their own, with the stride that keeps the generator's planning interval in seconds."""
+    (stride None: every FIRST_PLANNING_POSE-th pose), else a generator that plans every
+    `stride`-th guide pose. Guides sampled at a finer timestep than `timestep` (a variant's
+    `timestep` override) are judged at their own, with the stride that keeps the
+    generator's planning interval in seconds."""
     from leas_jax.contacts import GeneratorConfig
     from leas_jax.eval.evaluate import validate
 
+    poses = FIRST_PLANNING_POSE if stride is None else stride  # planning interval at `timestep`
     groups: dict[float, list] = {}
     for t in trajectories:
         groups.setdefault(variant_timestep(t.method, timestep), []).append(t)
     for dt, group in groups.items():
-        poses = stride if stride is not None else GeneratorConfig().stride
-        config = (
-            None
-            if stride is None and dt == timestep
-            else GeneratorConfig(stride=planning_stride(poses, timestep, dt))
-        )
+        config = GeneratorConfig(stride=planning_stride(poses, timestep, dt))
         validate(terrain, group, dt, workers, progress=True, desc="table II baselines", config=config)
 
 

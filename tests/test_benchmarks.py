@@ -196,9 +196,11 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     same 0.5 s planning interval, it is followed to the goal."""
     import table2_baselines as table2
 
+    from leas_jax.contacts import GeneratorConfig
     from leas_jax.eval.scenarios import cells_for, scenario_file
     from leas_jax.steering.baselines import BaselineConfig
 
+    assert table2.FIRST_PLANNING_POSE == GeneratorConfig().stride  # the defaults' planning interval
     assert table2.planning_stride(5, 0.1, 0.01) == 50 and table2.planning_stride(5, 0.1, 0.1) == 5
     assert table2.variant_timestep("rbkino_dt001", 0.1) == 0.01
     assert table2.variant_timestep("rbkino", 0.1) == 0.1

@@ -254,7 +254,7 @@ def main(argv=None) -> dict:
     failures = []
     explainer = ContactGenerator(arena, base)
     for k in failed:
-        index = failing_index(results[k].last_valid_index, len(guides[k]), base.stride)
+        index = failing_index(results[k].last_valid_index, len(guides[k]), base.planning_stride(env.timestep))
         speed, yaw_rate = motion_before(guides[k], index, env.timestep)
         _, reasons = explainer.stop_reasons(guides[k], env.timestep)
         failures.append(
@@ -313,7 +313,9 @@ def main(argv=None) -> dict:
             sum(any(name.endswith(": arm") for name in f["reasons"]) for f in failures)
         ),
         "cells_visited": dict(
-            Counter(kind_at(cells, p[:2]) for g in guides for p in g[:: base.stride]).most_common()
+            Counter(
+                kind_at(cells, p[:2]) for g in guides for p in g[:: base.planning_stride(env.timestep)]
+            ).most_common()
         ),
         "what_if": {
             name: {

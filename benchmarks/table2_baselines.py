@@ -26,11 +26,11 @@ and two diagnostics of the generator's turning:
   --sweep-steps    RBLin's in-place rotation over fewer steps (a faster turn in
                    place) on the 150..210 degree cells of `--sweep-speeds`;
   --generator-strides  RBKino's guides judged again by generators that plan every
-                   k-th guide pose (`GeneratorConfig.stride`, default 5: every 0.5 s;
-                   HPP's contact generator samples the guide every 0.01 s,
-                   hpp-rbprm-corba scenarios/abstract_contact_generator.py `dt`);
+                   k-th guide pose (`GeneratorConfig.planning_interval` k x timestep,
+                   default 0.5 s; HPP's contact generator samples the guide every
+                   0.01 s, hpp-rbprm-corba scenarios/abstract_contact_generator.py `dt`);
   per guide        the root's yaw change over the first 0.5 s (the generator's first
-                   planning pose, `GeneratorConfig.stride` x timestep) and the largest
+                   planning pose, `GeneratorConfig.planning_interval`) and the largest
                    one within any 0.5 s, next to its coverage.
 
     nice -n 10 python benchmarks/table2_baselines.py --out docs/results/2026-12-01-table2-baselines \\
@@ -71,7 +71,6 @@ VARIANTS = {
     "rbkino_dt001": ("rbkino", {"timestep": 0.01}),
 }
 BOOTSTRAP = 2000  # resamples of the mean-coverage interval
-FIRST_PLANNING_POSE = 5  # guide index of the generator's first planning pose (GeneratorConfig.stride)
 
 
 def parse_list(text: str, kind, name: str) -> list:
@@ -89,13 +88,13 @@ def bootstrap_mean(values: np.ndarray, seed: int = 0) -> tuple[float, float]:
     return float(np.percentile(means, 2.5)), float(np.percentile(means, 97.5))
 
 
-def first_turn_deg(guide: np.ndarray, poses: int = FIRST_PLANNING_POSE) -> float:
+def first_turn_deg(guide: np.ndarray, poses: int) -> float:
     """|yaw change| (deg) from the first guide pose to the generator's first planning pose (`poses` on)."""
     k = min(poses, len(guide) - 1)
     return float(abs(math.degrees(guide[k, 3] - guide[0, 3])))
 
 
-def max_turn_deg(guide: np.ndarray, poses: int = FIRST_PLANNING_POSE) -> float:
+def max_turn_deg(guide: np.ndarray, poses: int) -> float:
     """Largest |yaw change| (deg) over any `poses` consecutive steps (0.5 s at 0.1 s) of the guide."""
     k = min(poses, len(guide) - 1)
     return float(np.degrees(np.abs(guide[k:, 3] - guide[: len(guide) - k, 3])).max()) if k else 0.0
@@ -170,37 +169,36 @@ def build(jobs, terrain, field, cells, n_starts: int, base, env):
             s = starts[k]
             for n in range(len(s.poses)):
                 guide = steer(field, s.poses[n], target, float(s.speeds[n]), config)
-                t = Trajectory(k, label, s.poses[n], float(s.speeds[n]), float(s.yaw_offsets_deg[n]), guide)
-                out.append(t)
+                out.append(
+                    Trajectory(
+                        k,
+                        label,
+                        s.poses[n],
+                        float(s.speeds[n]),
+                        float(s.yaw_offsets_deg[n]),
+                        guide,
+                        timestep=config.timestep,
+                    )
+                )
     return out
 
 
 def judge(terrain, trajectories, timestep: float, workers: int, stride: int | None) -> None:
-    """Fill every trajectory's outcome with `evaluate.validate`: the generator's defaults
-    (stride None: every FIRST_PLANNING_POSE-th pose), else a generator that plans every
-    `stride`-th guide pose. Guides sampled at a finer timestep than `timestep` (a variant's
-    `timestep` override) are judged at their own, with the stride that keeps the
-    generator's planning interval in seconds."""
+    """Fill every trajectory's outcome with `evaluate.validate`, each guide at its own
+    timestep: the generator's defaults (stride None), else a generator planning every
+    `stride` x `timestep` s."""
     from leas_jax.contacts import GeneratorConfig
     from leas_jax.eval.evaluate import validate
 
-    poses = FIRST_PLANNING_POSE if stride is None else stride  # planning interval at `timestep`
-    groups: dict[float, list] = {}
-    for t in trajectories:
-        groups.setdefault(variant_timestep(t.method, timestep), []).append(t)
-    for dt, group in groups.items():
-        config = GeneratorConfig(stride=planning_stride(poses, timestep, dt))
-        validate(terrain, group, dt, workers, progress=True, desc="table II baselines", config=config)
+    config = None if stride is None else GeneratorConfig(planning_interval=stride * timestep)
+    validate(
+        terrain, trajectories, timestep, workers, progress=True, desc="table II baselines", config=config
+    )
 
 
 def variant_timestep(label: str, timestep: float) -> float:
     """s between the guide poses of a trajectory labelled `label`: its variant's override, else `timestep`."""
     return VARIANTS.get(label, ("", {}))[1].get("timestep", timestep)
-
-
-def planning_stride(stride: int, timestep: float, finer: float) -> int:
-    """Guide poses per planning pose at timestep `finer` for the planning interval of `stride` poses at `timestep`."""
-    return max(1, int(round(stride * timestep / finer)))
 
 
 def figure(report: dict, path: Path) -> None:
@@ -324,6 +322,7 @@ def main(argv=None) -> None:
     if args.n_starts < 1 or args.workers < 0 or any(s < 1 for s in steps + strides):
         raise UsageError("--n-starts, --sweep-steps and --generator-strides must be >= 1, --workers >= 0")
 
+    from leas_jax.contacts import GeneratorConfig
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for, scenario_file
     from leas_jax.steering.baselines import BaselineConfig
@@ -411,7 +410,7 @@ def main(argv=None) -> None:
             report["rblin_sweep"][f"{base.rotation_steps} steps, {cells[k].name}"] = row
 
     def half_second(label):  # guide poses in the generator's first planning interval
-        return planning_stride(FIRST_PLANNING_POSE, base.timestep, variant_timestep(label, base.timestep))
+        return GeneratorConfig().planning_stride(variant_timestep(label, base.timestep))
 
     report["trajectories"] = [
         {

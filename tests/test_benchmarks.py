@@ -200,8 +200,7 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     from leas_jax.eval.scenarios import cells_for, scenario_file
     from leas_jax.steering.baselines import BaselineConfig
 
-    assert table2.FIRST_PLANNING_POSE == GeneratorConfig().stride  # the defaults' planning interval
-    assert table2.planning_stride(5, 0.1, 0.01) == 50 and table2.planning_stride(5, 0.1, 0.1) == 5
+    assert GeneratorConfig().planning_stride(0.01) == 50 and GeneratorConfig().planning_stride(0.1) == 5
     assert table2.variant_timestep("rbkino_dt001", 0.1) == 0.01
     assert table2.variant_timestep("rbkino", 0.1) == 0.1
     terrain = load_terrain(scenario_file("ground"))
@@ -212,7 +211,7 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     turned = next(k for k, c in enumerate(cells) if c.yaw_deg == (60.0, 120.0) and c.speed[0] == 0.01)
     jobs = [(v, "rbkino", table2.VARIANTS[v][1], [turned]) for v in ("rbkino", "rbkino_dt001")]
     coarse, fine = table2.build(jobs, terrain, field, cells, 1, base, env)
-    assert len(fine.guide) > 9 * len(coarse.guide)
+    assert len(fine.guide) > 9 * len(coarse.guide) and (coarse.timestep, fine.timestep) == (0.1, 0.01)
     table2.judge(terrain, [coarse, fine], base.timestep, 0, None)
     assert coarse.outcome.last_valid_index == 0
     assert fine.outcome.coverage == 1.0 and fine.outcome.success

@@ -300,12 +300,28 @@ def test_bad_inputs():
 
 
 def test_config_is_frozen_and_used():
-    config = GeneratorConfig(stride=10)
+    config = GeneratorConfig(planning_interval=10 * DT)
     with pytest.raises(dataclasses.FrozenInstanceError):
-        config.stride = 3
+        config.planning_interval = 3 * DT
     generator = ContactGenerator(FLAT, config)
     plan = generator.plan(straight(0.0, 1.0), DT)
     assert set(np.unique(plan.guide_index)) <= set(range(0, len(plan.guide), 10)) | {len(plan.guide) - 1}
+
+
+def test_planning_interval_is_in_seconds_whatever_the_guide_timestep():
+    """The same straight walk sampled every DT and every DT / 10 is planned at the same
+    times (every 0.5 s), and both plans are covered."""
+    coarse = straight(0.0, 1.0)
+    t = np.arange(10 * (len(coarse) - 1) + 1) / 10.0
+    fine = np.column_stack([np.interp(t, np.arange(len(coarse)), coarse[:, k]) for k in range(4)])
+    generator = ContactGenerator(FLAT)
+    a, b = generator.plan(coarse, DT), generator.plan(fine, DT / 10)
+    assert a.coverage == b.coverage == 1.0
+    assert np.array_equal(10 * np.unique(a.guide_index), np.unique(b.guide_index))
+    assert GeneratorConfig().planning_stride(DT) == 5 and GeneratorConfig().planning_stride(DT / 10) == 50
+    for bad in (0.0, -0.5, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="planning_interval"):
+            GeneratorConfig(planning_interval=bad)
 
 
 def test_slow_leas_climb_of_eval_stairs_is_covered():

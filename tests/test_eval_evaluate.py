@@ -74,6 +74,19 @@ def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
             assert t["coverage"] < 1.0 and not t["success"]
         if t["method"] == "rbkino_rrt" and t["error"] is None:
             assert t["waypoints"][-1] == [5.0, 1.0]
+    # RBKino's continuous paths come sampled every 0.01 s, as HPP's contact generator samples
+    # them (the RRT's through its own nodes); the other guides at the env's 0.1 s.
+    for k, t in enumerate(trajectories):
+        if t["method"] in ("rbkino", "rbkino_rrt"):
+            assert t["timestep"] == 0.01
+            if t["error"] is None:
+                guide = guides[f"wall_scenario/{k}"]
+                step = np.hypot(*np.diff(guide[:, :2], axis=0).T)
+                assert step.max() <= 0.18 * 0.01 * np.sqrt(2) + 1e-9  # v_max per axis
+                for point in t["waypoints"] if t["method"] == "rbkino_rrt" else []:
+                    assert np.hypot(*(guide[:, :2] - point).T).min() < 1e-6
+        else:
+            assert "timestep" not in t
     # the two starts share one seeded draw across methods
     starts = {tuple(t["start"]) for t in trajectories}
     assert len(starts) == 2

@@ -9,7 +9,9 @@ the RRT's validity checks are jitted JAX):
    `rbkino_rrt` and `leas_rrt`), LeaS to the target (or along the waypoints),
    LeaS along the RRT's waypoints; navigate (`leas_jax.navigate`: the lattice
    search's waypoints for LeaS, validated and replanned in its own closed loop,
-   so its trajectories arrive with their outcome);
+   so its trajectories arrive with their outcome); RBKino's continuous paths (RBKino,
+   RBKino+RRT) sampled every `BaselineConfig.rbkino_timestep` (0.01 s, as HPP's contact
+   generator samples a path), the others one pose every env timestep;
 3. validate every other guide with the contact generator in one worker pool per
    terrain, with a progress bar;
 4. compute coverage and success per trajectory (`metrics`) and aggregate.
@@ -64,6 +66,8 @@ class Trajectory:
         outcome: `metrics.Outcome` once validated.
         error: why the method produced no guide, or None.
         replans: navigate's searches after the first (None for the other methods).
+        timestep: s between the guide's poses (None: the env's, `validate`'s `timestep`);
+            RBKino's continuous paths are sampled finer (`BaselineConfig.rbkino_timestep`).
     """
 
     cell: int
@@ -76,6 +80,7 @@ class Trajectory:
     outcome: metrics.Outcome | None = None
     error: str | None = None
     replans: int | None = None  # navigate: searches after the first
+    timestep: float | None = None
 
 
 @dataclass
@@ -117,11 +122,20 @@ def parse_methods(text: str | None) -> tuple[str, ...] | None:
     return names
 
 
+def guide_timestep(method: str, config) -> float | None:
+    """s between the poses of `method`'s guides where they are not the env's (None):
+    RBKino's continuous paths, sampled as HPP's contact generator samples them."""
+    return config.rbkino_timestep if method in ("rbkino", "rbkino_rrt") else None
+
+
 def _baseline_guides(method: str, field, starts: Starts, points: np.ndarray, config) -> list:
+    """RBLin's or RBKino's guide from every start to the route `points`, one pose every
+    `guide_timestep(method, config)` (else `config.timestep`)."""
     from leas_jax.steering.rbkino import rbkino, rbkino_through
     from leas_jax.steering.rblin import rblin, rblin_through
 
     single, through = (rblin, rblin_through) if method == "rblin" else (rbkino, rbkino_through)
+    config = dataclasses.replace(config, timestep=guide_timestep(method, config) or config.timestep)
     guides = []
     for pose, speed in zip(starts.poses, starts.speeds):
         if len(points) == 1:
@@ -269,6 +283,7 @@ def build_trajectories(
         (trajectories, seconds spent per method building guides).
     """
     from leas_jax.env import EnvConfig
+    from leas_jax.steering.rrt import path_guide
 
     env = env or (policy.config.env if policy is not None else EnvConfig())
     scenario = terrain.scenario
@@ -292,6 +307,7 @@ def build_trajectories(
                         guide=guides[n],
                         waypoints=None if waypoints is None else waypoints[n],
                         error=None if errors is None else errors[n],
+                        timestep=guide_timestep(method, config),
                     )
                 )
 
@@ -310,9 +326,15 @@ def build_trajectories(
             plans = _rrt_plans(field, terrain, env, starts, target, config, rrt_config, rrt_workers, progress)
             seconds["rrt_search"] = seconds.get("rrt_search", 0.0) + time.perf_counter() - began
         if "rbkino_rrt" in methods:
+            fine = dataclasses.replace(config, timestep=guide_timestep("rbkino_rrt", config))
             add(
                 "rbkino_rrt",
-                [p.guide if p.success else None for p in plans],
+                [
+                    path_guide(p.states, float(pose[3]), field, fine, env.reachability)[0]
+                    if p.success
+                    else None
+                    for p, pose in zip(plans, starts.poses)
+                ],
                 [p.waypoints if p.success else None for p in plans],
                 [None if p.success else "rrt: no path" for p in plans],
             )
@@ -394,6 +416,8 @@ def validate(
     """Run the contact generator on every guide (one pool), fill each trajectory's `outcome`
     (trajectories that arrive with one, navigate's, are left as they are). Host-only.
 
+    `timestep`: s between guide poses, where a trajectory does not set its own.
+
     `address`: a Ray cluster for the pool (`ValidationPool(address=...)`); None for local processes.
     `config`: the generator's `GeneratorConfig` (None: its defaults).
     """
@@ -410,7 +434,7 @@ def validate(
     if not todo:
         return
     with ValidationPool(terrain, workers=workers, address=address, config=config, return_plans=True) as pool:
-        futures = {pool.submit([t.guide], timestep): t for t in todo}
+        futures = {pool.submit([t.guide], t.timestep or timestep): t for t in todo}
         with tqdm(total=len(todo), desc=desc, disable=not progress, leave=False) as bar:
             for future in concurrent.futures.as_completed(futures):
                 t = futures[future]

@@ -102,6 +102,8 @@ def results_dict(results, policy=None, seconds: float = 0.0, leas_stop_at_invali
             )
             if t.replans is not None:
                 trajectories[-1]["replans"] = int(t.replans)
+            if t.timestep is not None:  # s between the guide's poses, where not the env's
+                trajectories[-1]["timestep"] = float(t.timestep)
         report["scenarios"][result.name] = {
             "terrain": result.terrain.path or result.terrain.name,
             "target": np.asarray(scenario.target).tolist(),

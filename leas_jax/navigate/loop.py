@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from leas_jax.contacts.planner.config import GeneratorConfig
 from leas_jax.errors import UsageError
 from leas_jax.navigate import result as reasons
 from leas_jax.navigate.lattice import LatticeConfig, build_lattice
@@ -369,8 +370,8 @@ class Navigator:
         # where the generator stopped (None: it covered the whole guide, the policy stopped short)
         failure = None
         if not outcome.success and 0 <= last < total - 1:
-            stride = getattr(cfg.generator, "stride", None) or 5
-            pose = guide[min(last + stride, total - 1)]
+            generator = cfg.generator or GeneratorConfig()
+            pose = guide[min(last + generator.planning_stride(self.env.timestep), total - 1)]
             failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
         state.attempts.append(
             Attempt(

@@ -53,6 +53,13 @@ class BaselineConfig:
     # in one step). The RRT (rrt.py) keeps "cruise" (see rbkino.py).
     rbkino_sync: str = "hpp"
     rotation_steps: int = 100  # RBLin's in-place rotation, paper §IV-B.1 ("here 100 steps")
+    # s between the poses of RBKino's continuous paths (RBKino, RBKino+RRT) handed to the
+    # contact generator: HPP's generator samples a path every 0.01 s (hpp-rbprm-corba,
+    # scenarios/abstract_contact_generator.py, `interpolate(0.01, ...)`). At `timestep` a root
+    # starting turned away from its goal turns 30-75 degrees between two poses, more than
+    # the generator follows (docs/results/2026-12-03-table2-hpp-sampling). RBLin's and
+    # LeaS's guides are their poses at `timestep`; the RRT checks its edges at `timestep`.
+    rbkino_timestep: float = 0.01
     nominal_root_height: float = 1.0  # m above the terrain, EnvConfig.nominal_root_height
 
     @classmethod

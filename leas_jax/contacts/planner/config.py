@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 from leas_jax.contacts.robot.database import DatabaseConfig
@@ -16,7 +17,10 @@ class GeneratorConfig:
     (tests/test_contacts_generator.py).
     """
 
-    stride: int = 5  # guide poses per planning pose, docs/design.md §6 ("every 5th pose by default")
+    # s between planning poses: every 5th guide pose at the env's 0.1 s (docs/design.md §6),
+    # whatever the guide's own timestep, so a guide sampled every 0.01 s as HPP's generator
+    # samples a path (RBKino, `BaselineConfig.rbkino_timestep`) is planned as often in time.
+    planning_interval: float = 0.5
     # Where a planning pose cannot be reached from the last one, the generator plans again at
     # every this-many guide poses between them. A root turning 30-100 degrees within 0.5 s
     # (RBKino starting turned away from its goal, Table II) leaves the feet beyond the hip-yaw
@@ -58,7 +62,7 @@ class GeneratorConfig:
     max_foot_offset: float = 0.32
     # rad, comfort region in yaw; the hip-yaw joints allow 0.35 rad inward, 1.57 rad outward
     max_foot_yaw: float = 0.5
-    max_steps_per_pose: int = 2  # steps per planning pose (0.5 s at the default stride and timestep)
+    max_steps_per_pose: int = 2  # steps per planning pose (0.5 s at the default planning_interval)
     max_root_offset_xy: float = (
         0.12  # m, root shift off the guide to reach equilibrium (~ half the foot spacing + margin)
     )
@@ -165,6 +169,11 @@ class GeneratorConfig:
                 f"GeneratorConfig.upper_bodies must name one or more of {sorted(UPPER_BODY_POSTURES)}, "
                 f"got {self.upper_bodies!r}"
             )
+        if not (isinstance(self.planning_interval, (int, float)) and 0.0 < self.planning_interval < math.inf):
+            raise ValueError(
+                f"GeneratorConfig.planning_interval must be a positive number of seconds, "
+                f"got {self.planning_interval!r}"
+            )
         if self.refine_stride is not None and not (
             isinstance(self.refine_stride, int) and self.refine_stride >= 1
         ):
@@ -184,6 +193,10 @@ class GeneratorConfig:
             "max_single_support_offset_xy",
             self.max_single_support_offset_xy,
         )
+
+    def planning_stride(self, timestep: float) -> int:
+        """Guide poses per planning pose for a guide sampled every `timestep` s (>= 1)."""
+        return max(1, int(round(self.planning_interval / timestep)))
 
     def retried(self, overrides) -> GeneratorConfig:
         """This config with one entry of `retry_settings` applied (and no retries of its own).

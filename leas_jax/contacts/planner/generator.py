@@ -6,7 +6,7 @@ Algorithm (docs/design.md §6, after the RB-PRM contact generator of Tonneau et 
 2018, used by the paper through [7]); its stages, in the order a guide meets them, are
 modules of this package:
 
-1. Contact planning runs on a subsampled guide: every `stride`-th pose plus the last.
+1. Contact planning runs on a subsampled guide: a pose every `planning_interval` s plus the last.
 2. `stance`: both soles at their half-sitting places under guide pose 0, moved onto
    support surfaces.
 3. `walking`: at each planning pose, keep both contacts, or step the foot that lags most
@@ -115,7 +115,7 @@ class ContactGenerator:
             postures.append(first)
             last_valid = 0
             passed = [(0, list(feet), 1)]  # (guide index, feet, postures so far) per planning pose
-            for index in planning_indices(len(guide), cfg.stride):
+            for index in planning_indices(len(guide), cfg.planning_stride(timestep)):
                 last_valid = self._reach(guide, timestep, last_valid, index, feet, postures)
                 if last_valid != index:
                     last_valid = self._retry(guide, timestep, index, passed, feet, postures, last_valid)

@@ -140,3 +140,37 @@ def save(name: str, payload: dict, load_before: dict, out: Path = RESULTS) -> Pa
     os.replace(partial, path)
     print(f"wrote {path} (load average {load_before['1min']} -> {record['load_average_after']['1min']})")
     return path
+
+
+def add_generator_settings_argument(parser: argparse.ArgumentParser) -> None:
+    """`--set NAME=VALUE` (repeatable): a GeneratorConfig field for the run (`generator_settings`)."""
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a GeneratorConfig field for this run, VALUE a Python literal "
+        "(e.g. --set 'retry_settings=()' --set max_candidates=12); repeatable",
+    )
+
+
+def generator_settings(assignments: list[str], parser) -> dict:
+    """{field: value} from `--set NAME=VALUE` arguments (VALUE a Python literal); a
+    malformed one, or a name GeneratorConfig has not, ends the run naming it."""
+    import ast
+    import dataclasses
+
+    from leas_jax.contacts.planner.config import GeneratorConfig
+
+    fields = {f.name for f in dataclasses.fields(GeneratorConfig)}
+    settings = {}
+    for assignment in assignments:
+        name, sep, text = assignment.partition("=")
+        name = name.strip()
+        if not sep or name not in fields:
+            parser.error(f"--set {assignment!r}: expected NAME=VALUE with NAME a GeneratorConfig field")
+        try:
+            settings[name] = ast.literal_eval(text.strip())
+        except (ValueError, SyntaxError):
+            parser.error(f"--set {assignment!r}: VALUE must be a Python literal")
+    return settings

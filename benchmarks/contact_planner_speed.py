@@ -27,7 +27,10 @@ BLAS/OpenMP pools are limited to one thread before NumPy is imported so that the
 figures are single-core ones. Writes <out>/contact_planner_speed.json.
 
     python benchmarks/contact_planner_speed.py [--runs 20] [--cases flat,uturn,stairs,arena]
-        [--arena-runs 3] [--profile flat|uturn|stairs|arena]
+        [--arena-runs 3] [--profile flat|uturn|stairs|arena] [--set NAME=VALUE ...]
+
+`--set NAME=VALUE` (repeatable) changes one GeneratorConfig field for the timed runs and the
+profile, e.g. `--set 'retry_settings=()'` for the generator without its retries.
 
 Plan identity across code changes: `--save-reference .cache/contact_parity/arena_reference.npz`
 stores the arena guides and the plans of all cases (q, feet, guide_index,
@@ -59,7 +62,7 @@ from pathlib import Path  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from common import add_out_argument, load_average, save  # noqa: E402
+from common import add_generator_settings_argument, add_out_argument, generator_settings, load_average, save  # noqa: E402
 
 from leas_jax.contacts import NOMINAL_ROOT_HEIGHT, ContactGenerator, GeneratorConfig  # noqa: E402
 from leas_jax.terrain import loads_terrain  # noqa: E402
@@ -190,10 +193,10 @@ def arena_guides(count: int = 24, seed: int = ARENA_SEED, length: int = 200, pos
     return terrain, guides
 
 
-def measure_arena(runs: int) -> dict:
+def measure_arena(runs: int, config: GeneratorConfig) -> dict:
     """Arena workload: guide poses per CPU-second (all submitted poses / CPU time of planning them)."""
     terrain, guides = arena_guides()
-    generator = ContactGenerator(terrain, GeneratorConfig())
+    generator = ContactGenerator(terrain, config)
     plans = [generator.plan(g, DT) for g in guides]  # warm-up
     cpu, wall = [], []
     for _ in range(runs):
@@ -227,9 +230,9 @@ def footsteps(plan) -> int:
     return int(np.isnan(plan.feet[:, :, 0]).any(axis=1).sum())
 
 
-def measure(name: str, runs: int) -> dict:
+def measure(name: str, runs: int, config: GeneratorConfig) -> dict:
     terrain, guide = CASES[name]()
-    generator = ContactGenerator(terrain, GeneratorConfig())
+    generator = ContactGenerator(terrain, config)
     plan = generator.plan(guide, DT)  # warm-up: first calls build caches (faces, LP)
     wall, cpu = [], []
     for _ in range(runs):
@@ -257,7 +260,7 @@ def measure(name: str, runs: int) -> dict:
     }
 
 
-def profile(name: str, runs: int) -> None:
+def profile(name: str, runs: int, config: GeneratorConfig) -> None:
     import cProfile
     import pstats
 
@@ -266,7 +269,7 @@ def profile(name: str, runs: int) -> None:
     else:
         terrain, guide = CASES[name]()
         guides = [guide]
-    generator = ContactGenerator(terrain, GeneratorConfig())
+    generator = ContactGenerator(terrain, config)
     for guide in guides:
         generator.plan(guide, DT)
     prof = cProfile.Profile()
@@ -352,23 +355,26 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--check-reference", metavar="NPZ", help="re-plan saved arena guides, compare, then exit"
     )
+    add_generator_settings_argument(parser)
     add_out_argument(parser)
     args = parser.parse_args(argv)
+    settings = generator_settings(args.set, parser)
+    config = GeneratorConfig(**settings)
     if args.save_reference:
         save_reference(args.save_reference)
         return
     if args.check_reference:
         sys.exit(0 if check_reference(args.check_reference) else 1)
     if args.profile:
-        profile(args.profile, args.runs)
+        profile(args.profile, args.runs, config)
         return
     names = [n.strip() for n in args.cases.split(",") if n.strip()]
     unknown = sorted(set(names) - {*CASES, "arena"})
     if unknown:
         parser.error(f"unknown case(s) {unknown}; choose from {[*CASES, 'arena']}")
     load_before = load_average()
-    results = {name: measure(name, args.runs) for name in CASES if name in names}
-    arena = measure_arena(args.arena_runs) if "arena" in names else None
+    results = {name: measure(name, args.runs, config) for name in CASES if name in names}
+    arena = measure_arena(args.arena_runs, config) if "arena" in names else None
     print(
         f"CPU ms per path ((wall) = wall-clock median), load average {load_before['1min']:.2f} before, "
         f"{load_average()['1min']:.2f} after"
@@ -418,6 +424,7 @@ def main(argv=None) -> None:
             "timestep_s": DT,
             "speed_m_s": SPEED,
             "targets": {"flat_path_ms": PATH_TARGET_MS, "ms_per_footstep": STEP_TARGET_MS},
+            "generator_settings": {name: repr(value) for name, value in settings.items()},
             "cases": results,
             **summary,
         },

@@ -100,27 +100,6 @@ def slowed(guide: np.ndarray, factor: int) -> np.ndarray:
     return np.stack([np.interp(fine, t, c) for c in (guide[:, 0], guide[:, 1], guide[:, 2], yaw)], axis=1)
 
 
-def generator_settings(assignments: list[str], parser) -> dict:
-    """{field: value} from `--set NAME=VALUE` arguments (VALUE a Python literal); a
-    malformed one, or a name GeneratorConfig has not, ends the run naming it."""
-    import ast
-
-    from leas_jax.contacts.planner.config import GeneratorConfig
-
-    fields = {f.name for f in dataclasses.fields(GeneratorConfig)}
-    settings = {}
-    for assignment in assignments:
-        name, sep, text = assignment.partition("=")
-        name = name.strip()
-        if not sep or name not in fields:
-            parser.error(f"--set {assignment!r}: expected NAME=VALUE with NAME a GeneratorConfig field")
-        try:
-            settings[name] = ast.literal_eval(text.strip())
-        except (ValueError, SyntaxError):
-            parser.error(f"--set {assignment!r}: VALUE must be a Python literal")
-    return settings
-
-
 def main_reason(reasons: dict) -> str:
     """The check that rejected most postures at a failure ("none" when nothing was tried)."""
     return max(reasons, key=reasons.get) if reasons else "none"
@@ -184,7 +163,14 @@ def compare(paths, out: Path) -> dict:
 
 
 def main(argv=None) -> dict:
-    from common import add_out_argument, load_average, save, wilson
+    from common import (
+        add_generator_settings_argument,
+        add_out_argument,
+        generator_settings,
+        load_average,
+        save,
+        wilson,
+    )
 
     from leas_jax.contacts.planner.config import GeneratorConfig
 
@@ -199,14 +185,7 @@ def main(argv=None) -> dict:
         default=",".join(GeneratorConfig().upper_bodies),
         help="comma-separated upper-body postures the generator may hold (GeneratorConfig.upper_bodies)",
     )
-    parser.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="a GeneratorConfig field for this run, VALUE a Python literal "
-        "(e.g. --set 'retry_settings=()' --set max_candidates=12); repeatable",
-    )
+    add_generator_settings_argument(parser)
     parser.add_argument(
         "--what-if", action="store_true", help="re-plan the failed guides with other settings"
     )

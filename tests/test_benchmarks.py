@@ -146,11 +146,11 @@ def test_guide_failures_sets_generator_fields_from_the_command_line():
     import guide_failures
 
     parser = argparse.ArgumentParser()
-    settings = guide_failures.generator_settings(["retry_settings=()", "max_candidates = 12"], parser)
+    settings = common.generator_settings(["retry_settings=()", "max_candidates = 12"], parser)
     assert settings == {"retry_settings": (), "max_candidates": 12}
     for bad in ("no_such_field=1", "max_candidates", "lookahead=fast"):
         with pytest.raises(SystemExit):
-            guide_failures.generator_settings([bad], parser)
+            common.generator_settings([bad], parser)
     report = {"policy": "p", "terrain": "t", "spawns": "condition", "upper_bodies": ["half_sitting"]}
     report |= {"generator_settings": {"max_candidates": "12"}, "starts": 1, "seed": 0}
     report |= {"full_coverage": 1.0, "full_coverage_95ci": [0.2, 1.0], "mean_coverage": 1.0}
@@ -215,3 +215,18 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     table2.judge(terrain, [coarse, fine], base.timestep, 0, None)
     assert coarse.outcome.last_valid_index == 0
     assert fine.outcome.coverage == 1.0 and fine.outcome.success
+
+
+def test_contact_planner_speed_times_the_generator_with_the_settings_given(tmp_path):
+    """`--set` reaches the timed generator: planning every 1 s instead of 0.5 s plans the
+    flat path through other postures, and the JSON records the setting."""
+    import contact_planner_speed as bench
+
+    reports = {}
+    for name, extra in (("default", []), ("coarse", ["--set", "planning_interval=1.0"])):
+        bench.main(["--cases", "flat", "--runs", "1", "--out", str(tmp_path / name), *extra])
+        reports[name] = json.loads((tmp_path / name / "contact_planner_speed.json").read_text())
+    default, coarse = (reports[k]["cases"]["flat"] for k in ("default", "coarse"))
+    assert reports["coarse"]["generator_settings"] == {"planning_interval": "1.0"}
+    assert reports["default"]["generator_settings"] == {}
+    assert default["coverage"] == coarse["coverage"] == 1.0 and default["postures"] != coarse["postures"]

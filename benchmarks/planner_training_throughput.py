@@ -6,6 +6,10 @@ and reports kept and rolled env steps per second and the fraction of time the
 learner waited for validation. Writes <out>/planner_training_throughput.json.
 
     python benchmarks/planner_training_throughput.py [--init runs/quick/geometric] [--iterations 8] [--workers 2]
+        [--set NAME=VALUE ...]
+
+`--set NAME=VALUE` (repeatable) changes one GeneratorConfig field of the workers' contact
+generator, e.g. `--set 'retry_settings=()'` to see what its retries cost.
 """
 
 from __future__ import annotations
@@ -19,10 +23,11 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from common import add_out_argument, load_average, save  # noqa: E402
+from common import add_generator_settings_argument, add_out_argument, generator_settings, load_average, save  # noqa: E402
 
 
 def main() -> None:
+    from leas_jax.contacts import GeneratorConfig
     from leas_jax.training import preset, train
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -30,8 +35,10 @@ def main() -> None:
     parser.add_argument("--iterations", type=int, default=8)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--num-envs", type=int, default=64, help="episodes per batch")
+    add_generator_settings_argument(parser)
     add_out_argument(parser)
     args = parser.parse_args()
+    settings = generator_settings(args.set, parser)
     load_before = load_average()
     overrides = dict(num_timesteps=10**9, num_envs=args.num_envs)
     if args.init:
@@ -49,6 +56,7 @@ def main() -> None:
             workers=args.workers,
             on_log=records.append,
             stop_after_iterations=args.iterations,
+            pool_options={"config": GeneratorConfig(**settings)},
         )
         wall = time.perf_counter() - t0
     steady = records[1:] or records  # the first iteration includes compilation and worker start-up
@@ -60,6 +68,7 @@ def main() -> None:
         "workers": args.workers,
         "episodes_per_batch": args.num_envs,
         "init": args.init,
+        "generator_settings": {name: repr(value) for name, value in settings.items()},
         "wall_s_total": round(wall, 1),
         "kept_steps_per_s": round(kept / span, 1),
         "rolled_steps_per_s": round(rolled / span, 1),

@@ -196,11 +196,6 @@ def judge(terrain, trajectories, timestep: float, workers: int, stride: int | No
     )
 
 
-def variant_timestep(label: str, timestep: float) -> float:
-    """s between the guide poses of a trajectory labelled `label`: its variant's override, else `timestep`."""
-    return VARIANTS.get(label, ("", {}))[1].get("timestep", timestep)
-
-
 def figure(report: dict, path: Path) -> None:
     """Coverage vs start yaw offset (ours vs paper), coverage vs first-0.5 s turn, RBLin turn-rate sweep."""
     import matplotlib
@@ -409,8 +404,8 @@ def main(argv=None) -> None:
             row["deg_per_s"] = 180.0 / (base.rotation_steps * base.timestep)
             report["rblin_sweep"][f"{base.rotation_steps} steps, {cells[k].name}"] = row
 
-    def half_second(label):  # guide poses in the generator's first planning interval
-        return GeneratorConfig().planning_stride(variant_timestep(label, base.timestep))
+    def half_second(t):  # guide poses in the generator's first planning interval
+        return GeneratorConfig().planning_stride(t.timestep)
 
     report["trajectories"] = [
         {
@@ -422,9 +417,9 @@ def main(argv=None) -> None:
             "success": t.outcome.success,
             "last_valid_index": t.outcome.last_valid_index,
             "guide_poses": len(t.guide),
-            "timestep": variant_timestep(t.method, base.timestep),
-            "first_turn_deg": first_turn_deg(t.guide, half_second(t.method)),
-            "max_turn_deg": max_turn_deg(t.guide, half_second(t.method)),
+            "timestep": t.timestep,
+            "first_turn_deg": first_turn_deg(t.guide, half_second(t)),
+            "max_turn_deg": max_turn_deg(t.guide, half_second(t)),
             "error": t.outcome.error,
         }
         for t in trajectories

@@ -201,8 +201,6 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     from leas_jax.steering.baselines import BaselineConfig
 
     assert GeneratorConfig().planning_stride(0.01) == 50 and GeneratorConfig().planning_stride(0.1) == 5
-    assert table2.variant_timestep("rbkino_dt001", 0.1) == 0.01
-    assert table2.variant_timestep("rbkino", 0.1) == 0.1
     terrain = load_terrain(scenario_file("ground"))
     env = EnvConfig()
     base = BaselineConfig.from_env(env)

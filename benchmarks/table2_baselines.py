@@ -35,7 +35,10 @@ and two diagnostics of the generator's turning:
 
     nice -n 10 python benchmarks/table2_baselines.py --out docs/results/2026-12-01-table2-baselines \\
         [--n-starts 60] [--workers 2] [--variants rblin,rbkino,rbkino_cruise] \\
-        [--sweep-steps 5,10,20,50] [--sweep-speeds 0.04] [--generator-strides 1]
+        [--sweep-steps 5,10,20,50] [--sweep-speeds 0.04] [--generator-strides 1] [--set NAME=VALUE ...]
+
+`--set NAME=VALUE` (repeatable) changes one GeneratorConfig field of the judging generator,
+e.g. `--set refine_stride=10` to refine a 0.01 s guide every 0.1 s only.
 
 Writes <out>/table2_baselines.json (per cell and variant: n, mean coverage with a 95 %
 bootstrap interval, fully covered and success fractions with 95 % Wilson intervals, the
@@ -56,9 +59,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common import (  # noqa: E402
+    add_generator_settings_argument,
+    generator_settings,
     load_average,
     provenance,
-    wilson,  # noqa: E402
+    wilson,
 )
 
 from leas_jax.errors import UsageError  # noqa: E402
@@ -183,14 +188,18 @@ def build(jobs, terrain, field, cells, n_starts: int, base, env):
     return out
 
 
-def judge(terrain, trajectories, timestep: float, workers: int, stride: int | None) -> None:
+def judge(
+    terrain, trajectories, timestep: float, workers: int, stride: int | None, settings: dict | None = None
+) -> None:
     """Fill every trajectory's outcome with `evaluate.validate`, each guide at its own
-    timestep: the generator's defaults (stride None), else a generator planning every
-    `stride` x `timestep` s."""
+    timestep: a generator with `settings` (GeneratorConfig fields; None: its defaults),
+    planning every `stride` x `timestep` s where `stride` is given."""
     from leas_jax.contacts import GeneratorConfig
     from leas_jax.eval.evaluate import validate
 
-    config = None if stride is None else GeneratorConfig(planning_interval=stride * timestep)
+    config = GeneratorConfig(**(settings or {}))
+    if stride is not None:
+        config = dataclasses.replace(config, planning_interval=stride * timestep)
     validate(
         terrain, trajectories, timestep, workers, progress=True, desc="table II baselines", config=config
     )
@@ -304,7 +313,9 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--generator-strides", default="", help="generator strides re-judging RBKino's guides ('' for none)"
     )
+    add_generator_settings_argument(parser)
     args = parser.parse_args(argv)
+    settings = generator_settings(args.set, parser)
     variants = parse_list(args.variants, str, "--variants")
     unknown = [v for v in variants if v not in VARIANTS]
     if unknown or not variants:
@@ -344,9 +355,9 @@ def main(argv=None) -> None:
             [(label, "rbkino", {}, all_cells)], terrain, field, cells, args.n_starts, base, env
         )
     built = time.perf_counter()
-    judge(terrain, trajectories, base.timestep, args.workers, None)
+    judge(terrain, trajectories, base.timestep, args.workers, None, settings)
     for stride, extra in rejudged.items():
-        judge(terrain, extra, base.timestep, args.workers, stride)
+        judge(terrain, extra, base.timestep, args.workers, stride, settings)
         trajectories += extra
     validated = time.perf_counter()
     titles = {
@@ -374,6 +385,7 @@ def main(argv=None) -> None:
         "command": "python benchmarks/table2_baselines.py "
         + " ".join(argv if argv is not None else sys.argv[1:]),
         "baseline_config": dataclasses.asdict(base),
+        "generator_settings": {name: repr(value) for name, value in settings.items()},
         "cells": [
             {
                 "name": c.name,

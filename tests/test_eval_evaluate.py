@@ -213,3 +213,26 @@ def test_leas_horizon_scales_with_the_route_and_keeps_the_minimum():
     # a polyline counts its whole length: 3 m + 4 m
     route = np.array([[3.0, 0.0], [3.0, 4.0]])
     assert leas_horizon([0.0, 0.0], route, 0.18, 0.1, 0, factor=1.0) == int(np.ceil(7.0 / 0.018))
+
+
+def test_rbkino_timestep_is_chosen_on_the_command_line(tmp_path, capsys):
+    """`--rbkino-timestep 0.05` samples RBKino's path every 0.05 s (results.json says so, the
+    guide's steps are bounded by v_max x 0.05 s); a non-positive or non-numeric value is a
+    one-line error naming the option."""
+    terrain = tmp_path / "wall.toml"
+    terrain.write_text(WALL_SCENARIO)
+    common = ["evaluate", "--terrain", str(terrain), "--methods", "rbkino", "--n-starts", "1"]
+    common += ["--workers", "0", "--no-progress"]
+    assert main([*common, "--rbkino-timestep", "0.05", "--out", str(tmp_path / "eval")]) == 0
+    (t,) = json.loads((tmp_path / "eval" / "results.json").read_text())["scenarios"]["wall_scenario"][
+        "trajectories"
+    ]
+    guide = np.load(tmp_path / "eval" / "guides.npz")["wall_scenario/0"]
+    assert t["timestep"] == 0.05 and guide.shape == (t["guide_length"], 4)
+    step = np.hypot(*np.diff(guide[:, :2], axis=0).T)
+    assert 0.18 * 0.01 * np.sqrt(2) < step.max() <= 0.18 * 0.05 * np.sqrt(2) + 1e-9
+    for bad in ("0", "-0.1", "fast", "inf"):
+        with pytest.raises(SystemExit):
+            main([*common, "--rbkino-timestep", bad, "--out", str(tmp_path / "bad")])
+        assert "--rbkino-timestep expects" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()

@@ -27,6 +27,19 @@ def _positive_int(name: str, allow_zero: bool = False, maximum: int | None = Non
     return parse
 
 
+def _positive_seconds(name: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} expects a number of seconds, got {text!r}") from None
+        if not 0.0 < value < float("inf"):
+            raise argparse.ArgumentTypeError(f"{name} expects a positive number of seconds, got {text!r}")
+        return value
+
+    return parse
+
+
 def _checkpoint(args):
     """--checkpoint as given, or loaded here when --allow-pickle lets a legacy pickle policy in."""
     if args.checkpoint is None or not args.allow_pickle:
@@ -69,6 +82,7 @@ def cmd_evaluate(args) -> int:
         progress=not args.no_progress,
         address=args.ray_address,
         leas_stop_at_invalid=args.leas_stop_at_invalid,
+        rbkino_timestep=args.rbkino_timestep,
     )
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))
@@ -184,6 +198,15 @@ def register(subparsers) -> None:
         help="end LeaS paths before the first pose the reachability condition rejects, as training "
         "episodes end (default: the policy rolls on and the contact generator alone judges its "
         "paths, as it judges the baselines' paths)",
+    )
+    parser.add_argument(
+        "--rbkino-timestep",
+        type=_positive_seconds("--rbkino-timestep"),
+        default=None,
+        metavar="S",
+        help="s between the poses of RBKino's and RBKino+RRT's paths handed to the contact generator "
+        "(default 0.01, as HPP's generator samples a path; 0.1, the env's, costs about a third of the "
+        "contact planning but the generator then cannot follow RBKino's turns from starts turned away)",
     )
     parser.set_defaults(func=cmd_evaluate)
 

@@ -482,6 +482,7 @@ def run_scenario(
     progress: bool = True,
     address: str | None = None,
     leas_stop_at_invalid: bool = False,
+    rbkino_timestep: float | None = None,
 ) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
@@ -498,6 +499,8 @@ def run_scenario(
         address: a Ray cluster address for the contact generator (None: local processes).
         leas_stop_at_invalid: LeaS paths end before the first pose the reachability
             condition rejects (False: the contact generator alone judges them).
+        rbkino_timestep: s between the poses of RBKino's paths (None: `config`'s,
+            `BaselineConfig.rbkino_timestep`).
     """
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
@@ -507,6 +510,8 @@ def run_scenario(
         raise UsageError(f"{terrain.path or terrain.name}: the terrain has no [scenario] table")
     env = policy.config.env if policy is not None else EnvConfig()
     config = config or BaselineConfig.from_env(env)
+    if rbkino_timestep is not None:
+        config = dataclasses.replace(config, rbkino_timestep=float(rbkino_timestep))
     field = heightfield_from_terrain(terrain, env)
     cells = cells_for(name, terrain.scenario)
     n = int(n_starts or terrain.scenario.n_starts)
@@ -554,6 +559,7 @@ def evaluate(
     figures: bool = True,
     address: str | None = None,
     leas_stop_at_invalid: bool = False,
+    rbkino_timestep: float | None = None,
 ) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
@@ -580,6 +586,8 @@ def evaluate(
             ~85 % specificity, and it rejects poses the generator walks through: 8 of
             the shipped policy's 10 circuit paths meet a rejected pose on a step down
             that the generator then walks).
+        rbkino_timestep: s between the poses of RBKino's and RBKino+RRT's paths (None:
+            `BaselineConfig.rbkino_timestep`, 0.01 s as HPP's contact generator samples a path).
 
     Returns:
         the results dictionary written to results.json.
@@ -622,6 +630,7 @@ def evaluate(
                 progress=progress,
                 address=address,
                 leas_stop_at_invalid=leas_stop_at_invalid,
+                rbkino_timestep=rbkino_timestep,
             )
         )
     report = tables.results_dict(

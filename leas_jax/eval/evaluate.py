@@ -482,7 +482,6 @@ def run_scenario(
     progress: bool = True,
     address: str | None = None,
     leas_stop_at_invalid: bool = False,
-    rbkino_timestep: float | None = None,
 ) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
@@ -499,8 +498,6 @@ def run_scenario(
         address: a Ray cluster address for the contact generator (None: local processes).
         leas_stop_at_invalid: LeaS paths end before the first pose the reachability
             condition rejects (False: the contact generator alone judges them).
-        rbkino_timestep: s between the poses of RBKino's paths (None: `config`'s,
-            `BaselineConfig.rbkino_timestep`).
     """
     from leas_jax.env import EnvConfig, heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
@@ -510,8 +507,6 @@ def run_scenario(
         raise UsageError(f"{terrain.path or terrain.name}: the terrain has no [scenario] table")
     env = policy.config.env if policy is not None else EnvConfig()
     config = config or BaselineConfig.from_env(env)
-    if rbkino_timestep is not None:
-        config = dataclasses.replace(config, rbkino_timestep=float(rbkino_timestep))
     field = heightfield_from_terrain(terrain, env)
     cells = cells_for(name, terrain.scenario)
     n = int(n_starts or terrain.scenario.n_starts)
@@ -592,8 +587,10 @@ def evaluate(
     Returns:
         the results dictionary written to results.json.
     """
+    from leas_jax.env import EnvConfig
     from leas_jax.eval import figures as figures_module
     from leas_jax.eval import tables
+    from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.terrain import load_terrain
 
     began = time.perf_counter()
@@ -616,6 +613,10 @@ def evaluate(
         workers = default_workers()  # on a Ray cluster, None: one actor per cluster CPU
     if workers is not None and int(workers) < 0:
         raise UsageError(f"--workers: expected an integer >= 0, got {workers}")
+    config = None  # run_scenario's default, from the policy's env
+    if rbkino_timestep is not None:
+        env = policy.config.env if policy is not None else EnvConfig()
+        config = BaselineConfig.from_env(env, rbkino_timestep=float(rbkino_timestep))
     results = []
     for name, terrain in jobs:
         results.append(
@@ -626,11 +627,11 @@ def evaluate(
                 policy,
                 n_starts,
                 workers,
+                config,
                 rrt_config=rrt_config,
                 progress=progress,
                 address=address,
                 leas_stop_at_invalid=leas_stop_at_invalid,
-                rbkino_timestep=rbkino_timestep,
             )
         )
     report = tables.results_dict(

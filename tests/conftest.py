@@ -12,6 +12,13 @@ the same tiny configs, and a program compiled once loads from the cache in the n
 (benchmarks/compile_cache.py: identical `train` calls after the first took 0.089 of their
 time without it, docs/results/2026-12-01-test-compile-cache).
 A JAX_COMPILATION_CACHE_DIR set by the caller is used as it is and kept.
+
+The test run also compiles with XLA's CPU backend at LLVM optimisation level 0
+(`TEST_XLA_FLAG`): the tests' programs are compiled once or twice and run on a few
+environments for a few steps, so compiling is most of their time, and level 0 halves it
+(benchmarks/compile_cache.py, docs/results/2026-12-03-test-compile-level). The programs
+compute the same thing (XLA uses no fast-math at either level). An optimisation level
+already in the caller's XLA_FLAGS is kept.
 """
 
 import os
@@ -23,6 +30,9 @@ import pytest
 
 _CACHE_ENV = "JAX_COMPILATION_CACHE_DIR"
 _CACHE_KEY = pytest.StashKey[str]()
+_FLAGS_ENV = "XLA_FLAGS"
+_FLAGS_KEY = pytest.StashKey[str | None]()
+TEST_XLA_FLAG = "--xla_backend_optimization_level=0"
 
 # node id -> why it is in the slow tier (what the fast tier keeps of it)
 _SMOKE = "tests/test_env_leas.py::test_smoke_jit_vmap_1024_envs"
@@ -35,7 +45,11 @@ SLOW_TIER = {
 
 def pytest_configure(config):
     """Give the test run its compilation cache (JAX reads the variable when it is imported;
-    subprocesses inherit it)."""
+    subprocesses inherit it) and its XLA optimisation level (read when the backend starts)."""
+    flags = os.environ.get(_FLAGS_ENV)
+    if "xla_backend_optimization_level" not in (flags or ""):
+        config.stash[_FLAGS_KEY] = flags
+        os.environ[_FLAGS_ENV] = f"{flags or ''} {TEST_XLA_FLAG}".strip()
     if os.environ.get(_CACHE_ENV):
         return
     path = tempfile.mkdtemp(prefix="leas-jax-compile-cache-")
@@ -46,6 +60,12 @@ def pytest_configure(config):
 
 
 def pytest_unconfigure(config):
+    if _FLAGS_KEY in config.stash:
+        flags = config.stash[_FLAGS_KEY]
+        if flags is None:
+            os.environ.pop(_FLAGS_ENV, None)
+        else:
+            os.environ[_FLAGS_ENV] = flags
     path = config.stash.get(_CACHE_KEY, None)
     if path is not None:
         os.environ.pop(_CACHE_ENV, None)

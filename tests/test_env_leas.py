@@ -46,7 +46,7 @@ def test_smoke_jit_vmap_1024_envs(path):
     assert first.obs.shape == (1024, 81) and state.obs.shape == (1024, 81)
     assert state.reward.shape == (1024,) and state.done.shape == (1024,)
     assert np.isfinite(np.asarray(state.obs)).all() and np.isfinite(np.asarray(state.reward)).all()
-    valid = jax.vmap(lambda p: reachability.valid(field, p))(first.pipeline_state.pose)
+    valid = jax.jit(jax.vmap(lambda p: reachability.valid(field, p)))(first.pipeline_state.pose)
     assert bool(valid.all()), "every reset pose satisfies the reachability condition"
 
 
@@ -54,7 +54,7 @@ def test_fresh_reset_draws_a_new_start():
     """After an episode ends the env restarts from a new random draw, not its first state."""
     config = EnvConfig(episode_length=3)
     env = FreshResetVmap(LeasEnv(flat_field(config), config))
-    state = env.reset(jax.random.split(jax.random.PRNGKey(3), 8))
+    state = jax.jit(env.reset)(jax.random.split(jax.random.PRNGKey(3), 8))
     starts = [np.asarray(state.pipeline_state.pos)]
     step = jax.jit(env.step)
     for _ in range(3):
@@ -118,7 +118,7 @@ def test_clearance_term_is_off_by_default_and_costs_its_weight_near_the_edge():
 
     def first_step(config):
         env = LeasEnv(heightfield_from_raster(heights, (0.0, 0.0), 0.02, -2.0, config), config)
-        return env.step(env.reset_to(pose, 0.0, target_dir=jnp.array([1.0, 0.0])), stand)
+        return jax.jit(lambda: env.step(env.reset_to(pose, 0.0, target_dir=jnp.array([1.0, 0.0])), stand))()
 
     paper = first_step(
         TRAINING_ENV

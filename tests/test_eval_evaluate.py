@@ -10,20 +10,22 @@ from leas_jax.cli import main
 from leas_jax.eval import metrics
 from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for
 
-# 6 x 4 m floor, a wall across x = 3 from y = 0 to y = 2.6 (the RRT goes round it),
-# starts near (1, 1), target (5, 1).
+# 4.5 x 3.5 m floor, a wall across x = 2.2 from y = 0 to y = 2 (the RRT goes round it),
+# starts near (1, 1), target (3.5, 1): short routes, since the generator plans RBKino's
+# every 0.01 s.
+WALL_TARGET = [3.5, 1.0]
 WALL_SCENARIO = """name = "wall_scenario"
-bounds = [[0.0, 0.0], [6.0, 4.0]]
+bounds = [[0.0, 0.0], [4.5, 3.5]]
 void_height = -2.0
 resolution = 0.05
 [[box]]
-center = [3.0, 2.0, -0.1]
-size = [6.0, 4.0, 0.2]
+center = [2.25, 1.75, -0.1]
+size = [4.5, 3.5, 0.2]
 [[box]]
-center = [3.0, 1.3, 0.75]
-size = [0.2, 2.6, 1.5]
+center = [2.2, 1.0, 0.75]
+size = [0.2, 2.0, 1.5]
 [scenario]
-target = [5.0, 1.0]
+target = [3.5, 1.0]
 start_region = [[0.9, 0.9], [1.1, 1.1]]
 start_yaw_deg = [-20.0, 20.0]
 start_speed = [0.0, 0.05]
@@ -73,7 +75,7 @@ def test_evaluate_writes_every_output(run_dir, tmp_path, capsys):
         if t["method"] in ("rblin", "rbkino"):
             assert t["coverage"] < 1.0 and not t["success"]
         if t["method"] == "rbkino_rrt" and t["error"] is None:
-            assert t["waypoints"][-1] == [5.0, 1.0]
+            assert t["waypoints"][-1] == WALL_TARGET
     # RBKino's continuous paths come sampled every 0.01 s, as HPP's contact generator samples
     # them (the RRT's through its own nodes); the other guides at the env's 0.1 s.
     for k, t in enumerate(trajectories):
@@ -190,7 +192,7 @@ def test_rrt_searches_are_the_same_in_worker_processes():
         terrain,
         env,
         starts,
-        np.array([5.0, 1.0]),
+        np.array(WALL_TARGET),
         BaselineConfig.from_env(env),
         RRTConfig(seed=3, max_iterations=400),
     )

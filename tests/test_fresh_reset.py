@@ -90,16 +90,25 @@ def test_same_starts_as_drawing_every_env(runs):
     np.testing.assert_allclose(obs, ref_obs, rtol=1e-3, atol=1e-4)
 
 
+@pytest.fixture(scope="module")
+def capacity_fns(runs):
+    """The runs' env's jitted `fresh_roots` and batched `random_root`, compiled once for
+    every count of finished envs (the count is data, not a shape)."""
+    config, field, _, _, _ = runs
+    env = LeasEnv(field, config)
+    return jax.jit(lambda root, done: fresh_roots(env, root, done)), jax.jit(jax.vmap(env.random_root))
+
+
 @pytest.mark.parametrize("count", [0, 1, 3, 10, 40, B])
-def test_each_capacity_draws_exactly_the_finished_envs(runs, count):
+def test_each_capacity_draws_exactly_the_finished_envs(runs, capacity_fns, count):
     """Counts in every gathered size of `reset_capacities(64)` = (1, 4, 16, 64): finished
     envs get `random_root` of their own key, the others keep their root."""
-    config, field, start, _, _ = runs
-    env = LeasEnv(field, config)
+    _, _, start, _, _ = runs
+    fresh, draw = capacity_fns
     done = np.zeros(B, bool)
     done[np.random.default_rng(count).choice(B, count, replace=False)] = True
-    got = jax.jit(lambda root, done: fresh_roots(env, root, done))(start, jnp.asarray(done))
-    drawn = jax.jit(jax.vmap(env.random_root))(start.rng)
+    got = fresh(start, jnp.asarray(done))
+    drawn = draw(start.rng)
     for name in ("rng", "steps", "pos", "yaw", "vel", "target_dir"):
         want = np.where(
             done.reshape((B,) + (1,) * (np.ndim(getattr(start, name)) - 1)),

@@ -228,3 +228,19 @@ def test_contact_planner_speed_times_the_generator_with_the_settings_given(tmp_p
     assert reports["coarse"]["generator_settings"] == {"planning_interval": "1.0"}
     assert reports["default"]["generator_settings"] == {}
     assert default["coverage"] == coarse["coverage"] == 1.0 and default["postures"] != coarse["postures"]
+
+
+def test_contact_worker_startup_times_each_stage_against_a_reference(tmp_path):
+    """benchmarks/contact_worker_startup.py: every stage timed in fresh processes, and a
+    reference checkout (here this one) measured alternately, with the ratio of the medians."""
+    import contact_worker_startup as startup
+
+    startup.main(["--runs", "1", "--reference", str(common.REPO), "--out", str(tmp_path)])
+    saved = json.loads((tmp_path / "contact_worker_startup.json").read_text())
+    assert {"machine", "git", "load_average_before"} <= set(saved)
+    for name in ("this", "reference"):
+        (start,) = saved["seconds"][name]
+        assert set(start) == set(startup.STAGES) and all(t > 0 for t in start.values())
+    assert set(saved["ratio_this_to_reference"]) == {*startup.STAGES, "total"}
+    with pytest.raises(SystemExit):
+        startup.main(["--reference", str(tmp_path)])  # not a checkout

@@ -20,6 +20,23 @@ def test_model_shape_and_reference(talos):
     assert M.load_talos() is talos  # cached once per process
 
 
+def test_the_model_parses_the_urdf_once(talos, monkeypatch):
+    """Building the model reads Talos's URDF (and its meshes) once, the slowest part of a
+    contact worker's start-up; its paths are those of the one loader."""
+    calls = []
+    build = pin.RobotWrapper.BuildFromURDF
+
+    def counted(*args, **kwargs):
+        calls.append(args[0])
+        return build(*args, **kwargs)
+
+    monkeypatch.setattr(pin.RobotWrapper, "BuildFromURDF", staticmethod(counted))
+    fresh = M.TalosModel()
+    assert calls == [fresh.urdf_path]
+    assert fresh.urdf_path == talos.urdf_path and fresh.srdf_path.endswith("talos.srdf")
+    assert fresh.file_digest == talos.file_digest and fresh.mass == talos.mass
+
+
 def test_nominal_root_height_is_measured_from_half_sitting(talos):
     # Half-sitting from the model with the root put back at its reference height:
     # both soles at z = 0, so the base height is NOMINAL_ROOT_HEIGHT.

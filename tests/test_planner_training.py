@@ -1,5 +1,6 @@
 """Planner-in-the-loop training: pruning, masked loss, end-to-end runs, worker deaths, resume."""
 
+import functools
 import os
 import shutil
 
@@ -48,7 +49,7 @@ def test_masked_loss_equals_brax_loss_without_mask():
     reward = jax.random.uniform(k[2], (b, t))
     done = jnp.zeros((b, t)).at[:, -1].set(1.0)
     logp = jax.random.normal(k[3], (b, t)) - 3.0
-    ours, ours_m = masked_ppo_loss(
+    ours, ours_m = jax.jit(lambda *args: masked_ppo_loss(*args, network, config))(
         state.params,
         state.normalizer,
         dict(
@@ -61,8 +62,6 @@ def test_masked_loss_equals_brax_loss_without_mask():
             mask=jnp.ones((b, t)),
         ),
         jax.random.PRNGKey(1),
-        network,
-        config,
     )
     data = Transition(
         observation=obs,
@@ -75,18 +74,16 @@ def test_masked_loss_equals_brax_loss_without_mask():
             "state_extras": {"truncation": jnp.zeros((b, t))},
         },
     )
-    theirs, theirs_m = ppo_losses.compute_ppo_loss(
-        state.params,
-        state.normalizer,
-        data,
-        jax.random.PRNGKey(1),
-        network,
+    brax_loss = functools.partial(
+        ppo_losses.compute_ppo_loss,
+        ppo_network=network,
         entropy_cost=config.entropy_cost,
         discounting=config.discounting,
         gae_lambda=config.gae_lambda,
         clipping_epsilon=config.clipping_epsilon,
         vf_coefficient=config.vf_coefficient,
     )
+    theirs, theirs_m = jax.jit(brax_loss)(state.params, state.normalizer, data, jax.random.PRNGKey(1))
     np.testing.assert_allclose(ours_m["policy_loss"], theirs_m["policy_loss"], rtol=1e-4, atol=1e-6)
     np.testing.assert_allclose(ours_m["v_loss"], theirs_m["v_loss"], rtol=1e-4, atol=1e-6)
     # the entropy of a tanh-Gaussian is estimated from samples, drawn in another layout: compare the rest

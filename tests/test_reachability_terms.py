@@ -308,7 +308,8 @@ def test_hands_term_spawn_points_keep_every_yaw_clear(wall_terrain):
     below = spawn[spawn[:, 1] < 2.5]  # the wall's top, 1.5 m wide, is ground too
     assert len(below) and below[:, 1].max() <= 2.5 - (math.hypot(0.12, 0.45) + 0.13) + 1e-6
     z = wall_terrain[np.round(spawn[:, 0] / RES).astype(int), np.round(spawn[:, 1] / RES).astype(int)] + 1.0
+    valid = jax.jit(jax.vmap(lambda p: reachability.valid(field, p, reach)))
     for yaw in np.linspace(0.0, 2 * math.pi, 9):
         batch = jnp.column_stack([jnp.asarray(spawn), jnp.asarray(z), jnp.full(len(spawn), yaw)])
-        ok = jax.vmap(lambda p: reachability.valid(field, p, reach))(batch)
+        ok = valid(batch)
         assert bool(ok.all())

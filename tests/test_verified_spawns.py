@@ -76,7 +76,7 @@ def test_only_poses_the_generator_stands_on_are_kept(pillar, verified):
 def test_resets_start_exactly_at_verified_poses(verified):
     field, _ = verified
     env = LeasEnv(field, CONFIG)
-    states = jax.vmap(env.reset)(jax.random.split(jax.random.PRNGKey(3), 64))
+    states = jax.jit(jax.vmap(env.reset))(jax.random.split(jax.random.PRNGKey(3), 64))
     poses = np.asarray(states.pipeline_state.pose)
     table = np.column_stack([np.asarray(field.spawn_xy), np.asarray(field.spawn_yaw)])
     for pose in poses:

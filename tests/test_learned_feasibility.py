@@ -252,7 +252,7 @@ def test_feasibility_condition_benchmark_runs_end_to_end(tmp_path, monkeypatch):
     weights = tmp_path / "w.npz"
     report = tmp_path / "report"
     bench.main(
-        ["--train-poses", "40", "--test-poses", "20", "--policy-train-poses", "0", "--policy-poses", "0"]
+        ["--train-poses", "24", "--test-poses", "12", "--policy-train-poses", "0", "--policy-poses", "0"]
         + [
             "--workers",
             "0",
@@ -269,7 +269,7 @@ def test_feasibility_condition_benchmark_runs_end_to_end(tmp_path, monkeypatch):
     saved = json.loads((report / "feasibility_condition.json").read_text())
     assert {"machine", "git", "load_average_before"} <= set(saved)
     learned = saved["validation"]["fresh"]["learned"]
-    assert learned["tp"] + learned["fn"] + learned["fp"] + learned["tn"] == 20
+    assert learned["tp"] + learned["fn"] + learned["fp"] + learned["tn"] == 12
     params, metadata = lf.load_params(weights)
     assert metadata["data_key"] == saved["data_key"]
     assert "| fresh |" in (report / "feasibility_condition.md").read_text()

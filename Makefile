@@ -5,6 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 RUN_NAME ?= quick
+# Test processes of `make test` (pytest-xdist, one test file per process at a time).
 JOBS ?= 2
 
 .PHONY: venv run lint test test-slow test-cluster bench clean
@@ -27,9 +28,10 @@ lint: $(STAMP)
 	$(VENV)/bin/ruff format --check .
 
 # The 30 slowest tests are listed after each run: what to move to the slow tier when the
-# fast one nears its 10-minute budget on 2 cores (tests/conftest.py).
+# fast one nears its 10-minute budget on 2 cores (tests/conftest.py). The files run in
+# JOBS processes; `make test JOBS=0` runs them in this one.
 test: lint
-	$(PY) -m pytest -q --durations=30
+	$(PY) -m pytest -q -n $(JOBS) --dist loadfile --durations=30
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -m slow

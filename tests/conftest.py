@@ -1,16 +1,18 @@
 """Shared fixtures, and the test tiers.
 
 `make test` runs the fast tier (`-m 'not slow'`, pyproject.toml), which must stay under 10
-minutes on 2 cores, lint included; `make test-slow` runs the rest. A test is slow when it is
-marked `@pytest.mark.slow` in its file, or listed in `SLOW_TIER` here: tests that only run
-again, on more inputs, what a fast test already checks (their assertions all still run in
-the slow tier). `make test` lists the 30 slowest tests after each run.
+minutes on 2 cores, lint included, in 2 pytest-xdist processes that each take a whole
+test file at a time (`--dist loadfile`: a file's module fixtures are built once);
+`make test-slow` runs the rest. A test is slow when it is marked `@pytest.mark.slow` in
+its file, or listed in `SLOW_TIER` here: tests that only run again, on more inputs, what
+a fast test already checks (their assertions all still run in the slow tier). `make test`
+lists the 30 slowest tests after each run.
 
-The processes of a test run (pytest's, CLI subprocesses, notebook kernels) share one JAX
-compilation cache, made for the run and removed after it: many tests train or roll out
-the same tiny configs, and a program compiled once loads from the cache in the next test
-(benchmarks/compile_cache.py: identical `train` calls after the first took 0.089 of their
-time without it, docs/results/2026-12-01-test-compile-cache).
+The processes of a test run (pytest's and its xdist workers, CLI subprocesses, notebook
+kernels) share one JAX compilation cache, made for the run and removed after it: many
+tests train or roll out the same tiny configs, and a program compiled once loads from the
+cache in the next test (benchmarks/compile_cache.py: identical `train` calls after the
+first took 0.089 of their time without it, docs/results/2026-12-01-test-compile-cache).
 A JAX_COMPILATION_CACHE_DIR set by the caller is used as it is and kept.
 
 The test run also compiles with XLA's CPU backend at LLVM optimisation level 0

@@ -86,6 +86,27 @@ def test_resume_continues_exactly(tmp_path, field):
     # keep_checkpoints=3: three step files at most, the newest last
     steps = [s for s, _ in checkpoint.list_checkpoints(tmp_path / "split")]
     assert steps[-1] == full.env_steps and len(steps) <= 3
+    # the state resumed from a file has a fresh state's argument types (weak-typed scalars
+    # included), so the jitted iteration is not compiled again for it
+    from leas_jax.training.ppo import init_state
+
+    fresh = init_state(config, field)
+    saved = checkpoint.load_state(checkpoint.list_checkpoints(tmp_path / "split")[0][1])
+    assert jax.tree.map(jax.typeof, checkpoint.like(fresh, saved)) == jax.tree.map(jax.typeof, fresh)
+    assert jax.tree.map(jax.typeof, jax.tree.map(jax.numpy.asarray, saved)) != jax.tree.map(jax.typeof, fresh)
+
+
+def test_like_gives_a_loaded_tree_the_fresh_trees_leaf_kinds():
+    """`checkpoint.like`: weakly typed scalars where the template has Python scalars, arrays
+    of its dtypes, the loaded values; a tree of another structure converted leaf by leaf."""
+    template = {"eps": 0.01, "count": jax.numpy.zeros((), jax.numpy.int32), "w": jax.numpy.zeros(3)}
+    loaded = {"eps": np.float32(0.5), "count": np.array(7, np.int64), "w": np.arange(3.0)}
+    like = checkpoint.like(template, loaded)
+    assert jax.typeof(like["eps"]) == jax.typeof(0.01) and float(like["eps"]) == 0.5
+    assert like["count"].dtype == jax.numpy.int32 and int(like["count"]) == 7
+    assert like["w"].dtype == jax.numpy.float32 and np.array_equal(like["w"], [0.0, 1.0, 2.0])
+    other = checkpoint.like(template, {"w": np.ones(2)})
+    assert set(other) == {"w"} and np.array_equal(other["w"], [1.0, 1.0])
 
 
 def test_resume_refuses_a_different_config(tmp_path, field):

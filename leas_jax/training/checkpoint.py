@@ -263,6 +263,28 @@ def to_host(tree):
     return jax.tree.map(np.asarray, jax.device_get(tree))
 
 
+def like(template, tree):
+    """`tree` (loaded from a file, NumPy leaves) in the form of `template` (the same tree
+    built fresh): device arrays of the template's types, weakly typed where the template
+    holds a Python scalar.
+
+    A file stores every leaf as a plain array, and a plain array is not weakly typed as a
+    Python scalar is (`normalizer.std_eps`): without this, a resumed run's jitted iteration
+    sees other argument types than an uninterrupted run's and compiles its program again
+    instead of loading it from the compilation cache. A tree of another structure (a file
+    of an earlier version) is converted leaf by leaf as it is.
+    """
+    if jax.tree.structure(template) != jax.tree.structure(tree):
+        return jax.tree.map(jax.numpy.asarray, tree)
+
+    def leaf(fresh, loaded):
+        if isinstance(fresh, (bool, int, float)):
+            return jax.numpy.asarray(type(fresh)(np.asarray(loaded).item()))  # weakly typed
+        return jax.numpy.asarray(loaded, dtype=fresh.dtype)
+
+    return jax.tree.map(leaf, template, tree)
+
+
 def list_checkpoints(run_dir: Path) -> list[tuple[int, Path]]:
     """[(env_steps, path)] of `checkpoints/step_*.ckpt` (and legacy `.pkl`) sorted by steps.
 

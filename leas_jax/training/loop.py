@@ -273,12 +273,12 @@ def train(
     initial = initial_params_from(init_from, allow_pickle) if resumed is None and init_from else None
     state: TrainState = init_state(config, field)
     if resumed is not None:
-        state = jax.tree.map(jax.numpy.asarray, resumed[0])
+        state = checkpoint.like(state, resumed[0])
     elif initial is not None:
         params, normalizer = initial
         state = state.replace(
-            params=jax.tree.map(jax.numpy.asarray, params),
-            normalizer=jax.tree.map(jax.numpy.asarray, normalizer),
+            params=checkpoint.like(state.params, params),
+            normalizer=checkpoint.like(state.normalizer, normalizer),
         )
     total = config.num_timesteps if config.mode == "planner" else config.num_iterations * config.batch_size
     log = RunLog(run_dir, config, state, resumed is not None, progress, total, on_log)

@@ -282,10 +282,9 @@ def build_trajectories(
     Returns:
         (trajectories, seconds spent per method building guides).
     """
-    from leas_jax.env import EnvConfig
     from leas_jax.steering.rrt import path_guide
 
-    env = env or (policy.config.env if policy is not None else EnvConfig())
+    env = env or policy_env(policy)
     scenario = terrain.scenario
     points = route(scenario)
     target = np.asarray(scenario.target, np.float64)
@@ -462,6 +461,13 @@ def policy_for(methods, checkpoint):
     return load_policy(checkpoint)
 
 
+def policy_env(policy):
+    """The EnvConfig a scenario is run with: the policy's (None: no LeaS method), else the default."""
+    from leas_jax.env import EnvConfig
+
+    return policy.config.env if policy is not None else EnvConfig()
+
+
 def default_workers() -> int:
     """Processes for the contact generator and the RRT searches: one per CPU this process may use
     (the main process only waits while they work)."""
@@ -499,13 +505,13 @@ def run_scenario(
         leas_stop_at_invalid: LeaS paths end before the first pose the reachability
             condition rejects (False: the contact generator alone judges them).
     """
-    from leas_jax.env import EnvConfig, heightfield_from_terrain
+    from leas_jax.env import heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.steering.rrt import RRTConfig
 
     if terrain.scenario is None:
         raise UsageError(f"{terrain.path or terrain.name}: the terrain has no [scenario] table")
-    env = policy.config.env if policy is not None else EnvConfig()
+    env = policy_env(policy)
     config = config or BaselineConfig.from_env(env)
     field = heightfield_from_terrain(terrain, env)
     cells = cells_for(name, terrain.scenario)
@@ -587,7 +593,6 @@ def evaluate(
     Returns:
         the results dictionary written to results.json.
     """
-    from leas_jax.env import EnvConfig
     from leas_jax.eval import figures as figures_module
     from leas_jax.eval import tables
     from leas_jax.steering.baselines import BaselineConfig
@@ -615,8 +620,7 @@ def evaluate(
         raise UsageError(f"--workers: expected an integer >= 0, got {workers}")
     config = None  # run_scenario's default, from the policy's env
     if rbkino_timestep is not None:
-        env = policy.config.env if policy is not None else EnvConfig()
-        config = BaselineConfig.from_env(env, rbkino_timestep=float(rbkino_timestep))
+        config = BaselineConfig.from_env(policy_env(policy), rbkino_timestep=float(rbkino_timestep))
     results = []
     for name, terrain in jobs:
         results.append(

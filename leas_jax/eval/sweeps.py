@@ -77,14 +77,13 @@ def hole_width_sweep(
         {"format", "policy", "widths", "methods", "view_half_width", "seconds",
          "rows": [{"width", "method", "n", "coverage", "success", "errors"}]}, percentages.
     """
-    from leas_jax.env import EnvConfig
-    from leas_jax.eval.evaluate import default_workers, policy_for, run_scenario
+    from leas_jax.eval.evaluate import default_workers, policy_env, policy_for, run_scenario
 
     began = time.perf_counter()
     widths = checked_widths(widths, repr(list(widths)))
     policy = policy_for(methods, checkpoint)
     workers = default_workers() if workers is None else workers
-    env = policy.config.env if policy is not None else EnvConfig()
+    env = policy_env(policy)
     rows, results = [], []
     for width in widths:
         result = run_scenario(

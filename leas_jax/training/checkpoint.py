@@ -271,18 +271,18 @@ def like(template, tree):
     A file stores every leaf as a plain array, and a plain array is not weakly typed as a
     Python scalar is (`normalizer.std_eps`): without this, a resumed run's jitted iteration
     sees other argument types than an uninterrupted run's and compiles its program again
-    instead of loading it from the compilation cache. A tree of another structure (a file
-    of an earlier version) is converted leaf by leaf as it is.
+    instead of loading it from the compilation cache. `tree` has the template's structure
+    except where it holds None (a planner run saves no env state): it stays None there.
     """
-    if jax.tree.structure(template) != jax.tree.structure(tree):
-        return jax.tree.map(jax.numpy.asarray, tree)
 
-    def leaf(fresh, loaded):
+    def leaf(loaded, fresh):
+        if loaded is None:
+            return None
         if isinstance(fresh, (bool, int, float)):
             return jax.numpy.asarray(type(fresh)(np.asarray(loaded).item()))  # weakly typed
         return jax.numpy.asarray(loaded, dtype=fresh.dtype)
 
-    return jax.tree.map(leaf, template, tree)
+    return jax.tree.map(leaf, tree, template, is_leaf=lambda node: node is None)
 
 
 def list_checkpoints(run_dir: Path) -> list[tuple[int, Path]]:

@@ -498,7 +498,8 @@ def _collision_geometry(collision_model, model):
 
 @functools.lru_cache(maxsize=1)
 def load_talos() -> TalosModel:
-    """The Talos model, loaded once per process (about 0.8 s the first time).
+    """The Talos model, loaded once per process (0.9 s the first time on 2 cores,
+    benchmarks/contact_worker_startup.py).
 
     Host-only, not jittable.
     """

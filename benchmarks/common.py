@@ -65,17 +65,49 @@ def git_state(repo: Path = REPO) -> dict:
 GIT_AT_START = git_state()
 
 
+VECTOR_ISAS = ("avx512f", "avx2", "avx")  # widest first: the widest the CPU reports is recorded
+
+
+def cpu_identity(cpuinfo: str) -> dict:
+    """The first processor of a /proc/cpuinfo text: model name, family / model / stepping and
+    the widest x86 vector extension it reports (`VECTOR_ISAS`, "none" if none).
+
+    The host behind "the 2-core AMD EPYC" is not always the same: its model name alone does not
+    tell a Zen 3 (family 25 model 1, AVX2, no AVX-512) from a Zen 4 (family 25 model 17,
+    AVX-512), and the same commits ran 2-3 x slower on some days than on others
+    (docs/results/2026-12-02-column-sampling). Comparing these fields says whether two figures
+    came from the same kind of CPU. Missing fields are None.
+    """
+    fields: dict[str, str] = {}
+    for line in cpuinfo.splitlines():
+        if not line.strip():
+            if fields:
+                break  # end of the first processor's block
+            continue
+        key, _, value = line.partition(":")
+        fields.setdefault(key.strip(), value.strip())
+    flags = set(fields.get("flags", "").split())
+    as_int = lambda key: int(fields[key]) if fields.get(key, "").isdigit() else None  # noqa: E731
+    return {
+        "cpu": fields.get("model name"),
+        "cpu_family": as_int("cpu family"),
+        "cpu_model": as_int("model"),
+        "cpu_stepping": as_int("stepping"),
+        "vector_isa": next((isa for isa in VECTOR_ISAS if isa in flags), "none"),
+    }
+
+
 def machine() -> dict:
-    """What the figures were measured on: CPU model, cores, memory, JAX backend and versions."""
+    """What the figures were measured on: CPU model and vector extensions (`cpu_identity`),
+    cores, memory, JAX backend and versions."""
     import jax
 
-    cpu = platform.processor() or platform.machine()
+    cpu = {"cpu": platform.processor() or platform.machine()}
     memory_gib = None
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
+        cpu.update(
+            {k: v for k, v in cpu_identity(Path("/proc/cpuinfo").read_text()).items() if v is not None}
+        )
         for line in Path("/proc/meminfo").read_text().splitlines():
             if line.startswith("MemTotal"):
                 memory_gib = round(int(line.split()[1]) / 2**20, 1)
@@ -84,7 +116,7 @@ def machine() -> dict:
         pass
     device = jax.devices()[0]
     return {
-        "cpu": cpu,
+        **cpu,
         "cores": os.cpu_count(),
         "memory_gib": memory_gib,
         "jax": jax.__version__,

@@ -119,6 +119,45 @@ def test_save_records_machine_load_and_commit(tmp_path):
     assert not list(path.parent.glob("*.partial"))
 
 
+ZEN3_CPUINFO = """processor\t: 0
+vendor_id\t: AuthenticAMD
+cpu family\t: 25
+model\t\t: 1
+model name\t: AMD EPYC
+stepping\t: 1
+flags\t\t: fpu sse sse2 avx fma avx2 bmi2 sha_ni
+
+processor\t: 1
+model name\t: another CPU
+flags\t\t: avx512f
+"""
+
+
+def test_cpu_identity_tells_hosts_apart_by_family_model_and_vector_extension():
+    zen3 = common.cpu_identity(ZEN3_CPUINFO)
+    assert zen3 == {
+        "cpu": "AMD EPYC",
+        "cpu_family": 25,
+        "cpu_model": 1,
+        "cpu_stepping": 1,
+        "vector_isa": "avx2",
+    }
+    zen4 = common.cpu_identity(
+        ZEN3_CPUINFO.replace("model\t\t: 1", "model\t\t: 17").replace("avx2", "avx2 avx512f")
+    )
+    assert (zen4["cpu_model"], zen4["vector_isa"]) == (17, "avx512f")
+    assert common.cpu_identity("model name\t: bare\nflags\t: fpu\n") == {
+        "cpu": "bare",
+        "cpu_family": None,
+        "cpu_model": None,
+        "cpu_stepping": None,
+        "vector_isa": "none",
+    }
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.exists():  # the record carries this host's identity
+        assert common.machine()["vector_isa"] == common.cpu_identity(cpuinfo.read_text())["vector_isa"]
+
+
 def test_guide_failures_report_names_why_the_generator_stopped():
     import guide_failures
 

@@ -26,7 +26,8 @@ generator covers fully, their mean coverage and the mean progress along the targ
         [--planner-steps N] [--starts 256] [--eval-seeds 0,1] [--scenarios eval_stairs ...]
 
 Writes DIR/feasibility_study.json, feasibility_study.md and feasibility_study.png; training
-runs go to DIR/runs/<method>/seed<k> (a finished run is reused).
+runs go to DIR/runs/<method>/seed<k>: a finished run is reused, and so is its evaluation
+(`study_evaluation.npz`, while the policy, the settings and the package's code are unchanged).
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+PACKAGE = Path(__file__).resolve().parent.parent / "leas_jax"
 METHODS = ("cylinders", "cylinders+planner", "learned", "learned+planner")
 METRICS = {  # name: (label, unit)
     "full_coverage": ("guides fully covered", "%"),
@@ -129,6 +131,77 @@ def train_method(method: str, seed: int, args, out: Path) -> Path:
     run = out / "runs" / method.replace("+", "_") / f"seed{seed}" / "planner"
     train(plan, run, progress=False, workers=args.workers)
     return run
+
+
+EVALUATION_FILE = "study_evaluation.npz"  # in a run's directory: its evaluation, reused by a resumed study
+# the arguments an evaluation depends on (with the policy file and the package's code)
+EVALUATION_SETTINGS = (
+    "starts",
+    "eval_seeds",
+    "ground_starts",
+    "episode_length",
+    "scenarios",
+    "scenario_starts",
+)
+
+
+def evaluation_key(run_dir: Path, args) -> str:
+    """sha256 (hex) of what `evaluate_policy(run_dir, args)` depends on: the run's policy file
+    (bytes), the evaluation settings (`EVALUATION_SETTINGS`) and every .py file of the package
+    (the generator, the env and the evaluation alike; any change re-evaluates)."""
+    import hashlib
+
+    from leas_jax.feasibility.spawns import generator_code_digest
+    from leas_jax.training.checkpoint import policy_file
+
+    digest = hashlib.sha256(b"leas-study-evaluation-v1")
+    digest.update(policy_file(run_dir).read_bytes())
+    settings = {name: getattr(args, name) for name in EVALUATION_SETTINGS}
+    digest.update(json.dumps(settings, sort_keys=True, default=list).encode())
+    digest.update(generator_code_digest(roots=(PACKAGE,)).encode())
+    return digest.hexdigest()
+
+
+def cached_evaluation(run_dir: Path, args, evaluate=None) -> dict:
+    """`evaluate(run_dir, args)` (default `evaluate_policy`), read from the run's
+    `EVALUATION_FILE` where it holds this `evaluation_key`, else computed and written there
+    (atomically): a study stopped during a long evaluation campaign resumes without
+    evaluating its finished policies again. A damaged or stale file is recomputed."""
+    import io
+
+    from leas_jax.files import atomic_write_bytes
+
+    evaluate = evaluate or evaluate_policy
+    path = Path(run_dir) / EVALUATION_FILE
+    key = evaluation_key(run_dir, args)
+    try:
+        with np.load(path) as data:
+            if str(data["key"]) == key:
+                return _unflatten({name: data[name] for name in data.files if name != "key"})
+    except (OSError, ValueError, KeyError):  # missing or damaged: evaluate again
+        pass
+    result = evaluate(run_dir, args)
+    buffer = io.BytesIO()
+    np.savez(buffer, key=np.array(key), **_flatten(result))
+    atomic_write_bytes(path, buffer.getvalue())
+    return result
+
+
+def _flatten(result: dict) -> dict:
+    """An evaluation's arrays under flat names (`scenarios/<name>` for its scenarios)."""
+    flat = {name: values for name, values in result.items() if name != "scenarios"}
+    flat.update({f"scenarios/{name}": values for name, values in result.get("scenarios", {}).items()})
+    return flat
+
+
+def _unflatten(flat: dict) -> dict:
+    result = {name: np.asarray(values) for name, values in flat.items() if "/" not in name}
+    scenarios = {
+        name.split("/", 1)[1]: np.asarray(v) for name, v in flat.items() if name.startswith("scenarios/")
+    }
+    if scenarios:
+        result["scenarios"] = scenarios
+    return result
 
 
 def evaluate_policy(run_dir: Path, args) -> dict:
@@ -396,7 +469,7 @@ def main(argv=None) -> dict:
             t0 = time.perf_counter()
             run = train_method(method, seed, args, out)
             t1 = time.perf_counter()
-            per_seed[method].append(evaluate_policy(run, args))
+            per_seed[method].append(cached_evaluation(run, args))
             timings[f"{method}/seed{seed}"] = {
                 "train_s": round(t1 - t0, 1),
                 "eval_s": round(time.perf_counter() - t1, 1),

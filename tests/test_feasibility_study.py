@@ -60,6 +60,47 @@ def test_summary_table_and_figure(tmp_path):
     assert (tmp_path / "feasibility_study.png").is_file()
 
 
+def test_a_finished_policys_evaluation_is_reused_until_its_inputs_change(tmp_path):
+    import argparse
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "policy.ckpt").write_bytes(b"weights 1")
+    args = argparse.Namespace(
+        starts=3,
+        eval_seeds=(0,),
+        ground_starts=3,
+        episode_length=60,
+        scenarios=["eval_stairs"],
+        scenario_starts=2,
+    )
+    calls = []
+
+    def evaluate(run_dir, args):
+        calls.append(args.starts)
+        return {
+            "full_coverage": np.array([1.0, 0.0, 1.0]),
+            "progress_m": np.array([3.0, 2.5, 0.5]),
+            "scenarios": {"eval_stairs": np.array([1.0, 0.0])},
+        }
+
+    first = fs.cached_evaluation(run, args, evaluate)
+    again = fs.cached_evaluation(run, args, evaluate)
+    assert calls == [3]  # read back, not evaluated again
+    assert set(again) == set(first) and set(again["scenarios"]) == {"eval_stairs"}
+    np.testing.assert_array_equal(again["progress_m"], first["progress_m"])
+    np.testing.assert_array_equal(again["scenarios"]["eval_stairs"], [1.0, 0.0])
+    args.starts = 4  # other settings
+    fs.cached_evaluation(run, args, evaluate)
+    (run / "policy.ckpt").write_bytes(b"weights 2")  # the run trained on
+    fs.cached_evaluation(run, args, evaluate)
+    (run / fs.EVALUATION_FILE).write_bytes(b"damaged")
+    fs.cached_evaluation(run, args, evaluate)
+    assert calls == [3, 4, 4, 4]
+    fs.cached_evaluation(run, args, evaluate)
+    assert calls == [3, 4, 4, 4]
+
+
 def test_bad_arguments_name_the_option(tmp_path):
     with pytest.raises(UsageError, match="--methods"):
         fs.main(["--out", str(tmp_path), "--methods", "cylinders,boxes"])

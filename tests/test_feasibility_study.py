@@ -152,6 +152,8 @@ def test_study_runs_end_to_end_on_tiny_settings(tmp_path):
     assert (tmp_path / "feasibility_study.png").is_file() and (tmp_path / "feasibility_study.md").is_file()
     runs = tmp_path / "runs"
     assert (runs / "learned_planner" / "seed0" / "planner" / "condition_data.npz").is_file()
+    for run in ("cylinders/seed0/geometric", "learned_planner/seed0/planner"):  # a resumed study reads them
+        assert (runs / run / fs.EVALUATION_FILE).is_file()
     # a planner phase continues its method's own geometric run: no second geometric run
     assert not (runs / "cylinders_planner" / "seed0" / "geometric").exists()
     assert not (runs / "learned_planner" / "seed0" / "geometric").exists()

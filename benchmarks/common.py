@@ -97,6 +97,17 @@ def cpu_identity(cpuinfo: str) -> dict:
     }
 
 
+def cpu_summary(machine_record: dict) -> str:
+    """One line naming a `machine()` record's CPU, e.g. "AMD EPYC, family 25 model 1, avx2, 2 cores"."""
+    parts = [str(machine_record.get("cpu"))]
+    if machine_record.get("cpu_family") is not None:
+        parts.append(f"family {machine_record['cpu_family']} model {machine_record.get('cpu_model')}")
+    if machine_record.get("vector_isa"):
+        parts.append(machine_record["vector_isa"])
+    parts.append(f"{machine_record.get('cores')} cores")
+    return ", ".join(parts)
+
+
 def machine() -> dict:
     """What the figures were measured on: CPU model and vector extensions (`cpu_identity`),
     cores, memory, JAX backend and versions."""
@@ -170,7 +181,10 @@ def save(name: str, payload: dict, load_before: dict, out: Path = RESULTS) -> Pa
     partial = path.with_name(path.name + ".partial")
     partial.write_text(json.dumps(record, indent=2) + "\n")
     os.replace(partial, path)
-    print(f"wrote {path} (load average {load_before['1min']} -> {record['load_average_after']['1min']})")
+    print(
+        f"wrote {path} (load average {load_before['1min']} -> {record['load_average_after']['1min']}; "
+        f"{cpu_summary(record['machine'])})"
+    )
     return path
 
 

@@ -153,6 +153,10 @@ def test_cpu_identity_tells_hosts_apart_by_family_model_and_vector_extension():
         "cpu_stepping": None,
         "vector_isa": "none",
     }
+    assert (
+        common.cpu_summary({"cpu": "AMD EPYC", **zen3, "cores": 2})
+        == "AMD EPYC, family 25 model 1, avx2, 2 cores"
+    )
     cpuinfo = Path("/proc/cpuinfo")
     if cpuinfo.exists():  # the record carries this host's identity
         assert common.machine()["vector_isa"] == common.cpu_identity(cpuinfo.read_text())["vector_isa"]

@@ -332,17 +332,20 @@ def markdown(report: dict) -> str:
     lines = [
         "# Feasibility ablation",
         "",
-        f"{len(s.get('seeds_done', s['seeds']))} training seeds ({', '.join(map(str, s.get('seeds_done', s['seeds'])))}), {s['geometric_steps']} geometric + {s['planner_steps']} planner env steps "
+        f"{len(s.get('seeds_done', s['seeds']))} training seeds ({', '.join(map(str, s.get('seeds_done', s['seeds'])))}; `seeds`: those each method finished), {s['geometric_steps']} geometric + {s['planner_steps']} planner env steps "
         f"(a planner phase continues its method's geometric run of the same seed); {s['starts']} arena starts x "
         f"{len(s['eval_seeds'])} evaluation seeds, {s['episode_length']}-step episodes. Mean [95 % interval "
         "across seeds and starts].",
         "",
-        "| method | " + " | ".join(label(m) for m in metrics) + " |",
-        "|---|" + "---|" * len(metrics),
+        "| method | seeds | " + " | ".join(label(m) for m in metrics) + " |",
+        "|---|---|" + "---|" * len(metrics),
     ]
     for method, row in table.items():
+        seeds = len(row[next(iter(METRICS))]["per_seed"])  # a study stopped early: fewer for some methods
         lines.append(
-            f"| {method} | " + " | ".join(_cell(row[m], unit(m)) if m in row else "-" for m in metrics) + " |"
+            f"| {method} | {seeds} | "
+            + " | ".join(_cell(row[m], unit(m)) if m in row else "-" for m in metrics)
+            + " |"
         )
     return "\n".join(lines) + "\n"
 

@@ -50,13 +50,13 @@ def test_summary_table_and_figure(tmp_path):
         },
     }
     text = fs.markdown(report)
-    assert "| cylinders | 66.7 [" in text and "eval_stairs success (%)" in text
+    assert "| cylinders | 2 | 66.7 [" in text and "eval_stairs success (%)" in text
     fs.figure(report, tmp_path / "f.png")
     assert (tmp_path / "f.png").stat().st_size > 1000
     report["settings"]["seeds_done"] = [0]  # a study stopped after its first seed
     (tmp_path / "feasibility_study.json").write_text(json.dumps(report))
     fs.main(["--out", str(tmp_path), "--tables-only"])
-    assert "1 training seeds (0)" in (tmp_path / "feasibility_study.md").read_text()
+    assert "1 training seeds (0;" in (tmp_path / "feasibility_study.md").read_text()
     assert (tmp_path / "feasibility_study.png").is_file()
 
 

@@ -87,7 +87,10 @@ def cpu_identity(cpuinfo: str) -> dict:
         key, _, value = line.partition(":")
         fields.setdefault(key.strip(), value.strip())
     flags = set(fields.get("flags", "").split())
-    as_int = lambda key: int(fields[key]) if fields.get(key, "").isdigit() else None  # noqa: E731
+
+    def as_int(key: str) -> int | None:
+        return int(fields[key]) if fields.get(key, "").isdigit() else None
+
     return {
         "cpu": fields.get("model name"),
         "cpu_family": as_int("cpu family"),

@@ -195,6 +195,7 @@ def _flatten(result: dict) -> dict:
 
 
 def _unflatten(flat: dict) -> dict:
+    """The inverse of `_flatten`: an evaluation's dict from its flat arrays."""
     result = {name: np.asarray(values) for name, values in flat.items() if "/" not in name}
     scenarios = {
         name.split("/", 1)[1]: np.asarray(v) for name, v in flat.items() if name.startswith("scenarios/")

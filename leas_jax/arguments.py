@@ -10,15 +10,26 @@ import argparse
 import math
 
 
-def positive_int(text: str) -> int:
-    """argparse type: an integer > 0 (underscores allowed, as in 150_000)."""
+def _integer_at_least(text: str, minimum: int, expected: str) -> int:
+    """An integer >= `minimum` parsed from `text` (underscores allowed, as in 150_000), else an
+    argparse error saying what was `expected`."""
     try:
         value = int(text.replace("_", ""))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}") from None
+    if value < minimum:
+        raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
     return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer > 0 (underscores allowed, as in 150_000)."""
+    return _integer_at_least(text, 1, "a positive integer")
+
+
+def non_negative_int(text: str) -> int:
+    """argparse type: an integer >= 0 (underscores allowed)."""
+    return _integer_at_least(text, 0, "an integer >= 0")
 
 
 def comma_floats(count: int, name: str):

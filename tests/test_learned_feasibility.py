@@ -214,6 +214,28 @@ def test_train_command_selects_the_learned_condition():
     assert default.env.condition == "cylinders"
 
 
+def test_train_command_sets_or_freezes_the_dagger_refits():
+    """`--condition-refresh-every N` sets the planner phase's refit period (0: the condition stays
+    as loaded); outside `--mode planner --reachability learned`, or below 0, it is refused."""
+    from leas_jax.cli import build_parser
+    from leas_jax.errors import UsageError
+    from leas_jax.training.commands import config_from_args
+
+    parser = build_parser()
+    planner = ["train", "--out", "r", "--mode", "planner", "--preset", "smoke", "--reachability", "learned"]
+    for period in (0, 7):
+        config = config_from_args(parser.parse_args([*planner, "--condition-refresh-every", str(period)]))
+        assert config.condition_refresh_every == period and config.env.condition == "learned"
+    for misplaced in (
+        ["train", "--out", "r", "--preset", "smoke", "--reachability", "learned"],
+        ["train", "--out", "r", "--mode", "planner", "--preset", "smoke"],
+    ):
+        with pytest.raises(UsageError, match="--condition-refresh-every"):
+            config_from_args(parser.parse_args([*misplaced, "--condition-refresh-every", "0"]))
+    with pytest.raises(SystemExit):
+        parser.parse_args([*planner, "--condition-refresh-every", "-1"])
+
+
 def test_train_command_takes_other_condition_weights(tmp_path):
     """`--condition-weights FILE` selects the learned condition's weights; a missing file or the
     option without `--reachability learned` is refused naming the option."""

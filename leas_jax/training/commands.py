@@ -13,13 +13,11 @@ from leas_jax.arguments import (
     positive_int,
 )
 from leas_jax.errors import UsageError
-from leas_jax.training.config import LEARNED_REFRESH_EVERY
+from leas_jax.training.config import LEARNED_REFRESH_EVERY, PRESETS, learned_condition_env, preset
 
 
 def add_training_arguments(parser) -> None:
     """The arguments of `leas train`, which `leas run` takes too."""
-    from leas_jax.training.config import PRESETS
-
     parser.add_argument(
         "--preset",
         default="quick",
@@ -129,7 +127,6 @@ def add_training_arguments(parser) -> None:
 
 def config_from_args(args):
     """TrainConfig of the parsed `leas train` / `leas run` arguments."""
-    from leas_jax.training.config import preset
 
     overrides = {}
     if args.init is not None:
@@ -165,7 +162,6 @@ def config_from_args(args):
     if args.reachability == "learned":
         from leas_jax.env.config import EnvConfig
         from leas_jax.env.learned_weights import resolve_weights
-        from leas_jax.training.config import learned_condition_env
 
         if weights is None:
             weights = EnvConfig.learned_weights

@@ -105,6 +105,7 @@ def method_configs(method: str, seed: int, args):
         env=env,
         condition_refresh_every=args.refresh_every if method == "learned+planner" else 0,
         condition_refresh_min_poses=args.refresh_min_poses,
+        condition_refresh_sensitivity=args.refresh_sensitivity,
     )
     return geo, plan
 
@@ -416,6 +417,13 @@ def main(argv=None) -> dict:
         "--refresh-every", type=int, default=4, help="learned+planner: DAgger refresh period (iterations)"
     )
     parser.add_argument("--refresh-min-poses", type=int, default=400)
+    parser.add_argument(
+        "--refresh-sensitivity",
+        type=float,
+        default=None,
+        help="learned+planner: the share of held-aside feasible poses a refit keeps feasible "
+        "(TrainConfig.condition_refresh_sensitivity; default FitConfig's 0.95)",
+    )
     parser.add_argument("--weights", default="checkpoints/feasibility/walking.npz")
     parser.add_argument("--starts", type=int, default=256, help="arena starts per evaluation seed")
     parser.add_argument("--eval-seeds", default="0,1")

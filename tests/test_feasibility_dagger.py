@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import jax
 import jax.numpy as jnp
 import numpy as np
+import pytest
 
 from leas_jax.env import learned_feasibility as lf
 from leas_jax.training import preset, train
@@ -222,3 +223,46 @@ def test_train_command_takes_seed_data_for_the_dagger_phase_only(tmp_path):
             UsageError, match="--condition-seed-data is for --mode planner --reachability learned"
         ):
             config_from_args(parser.parse_args([*base, *extra]))
+
+
+def test_a_refit_sets_its_threshold_for_the_configured_sensitivity(tmp_path, monkeypatch):
+    """`TrainConfig.condition_refresh_sensitivity` is the target sensitivity a refit sets its
+    threshold for (None: FitConfig's); a higher one gives a threshold no higher, from the same
+    data and weights."""
+    import leas_jax.feasibility as feasibility
+    from leas_jax.env import heightfield_from_terrain
+    from leas_jax.errors import UsageError
+    from leas_jax.feasibility import FitConfig
+    from leas_jax.terrain import load_terrain
+    from leas_jax.training.planner import VerdictData
+
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=reach)
+    weights = lf.save_params(tmp_path / "start.npz", {**params, "threshold": jnp.asarray(0.0)})
+    env = dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(weights))
+    field = heightfield_from_terrain(load_terrain("terrains/eval_ground.toml"), env)
+    guides = [_guide(60, x0) for x0 in np.linspace(2.0, 6.0, 12)]
+    last_valid = np.array([29 if k % 2 else 59 for k in range(12)])
+    fit, used = feasibility.fit, []
+
+    def spy(x, y, config, **kwargs):
+        used.append(config.target_sensitivity)
+        return fit(x, y, config, **kwargs)
+
+    monkeypatch.setattr(feasibility, "fit", spy)
+    thresholds = []
+    for sensitivity in (None, 1.0):
+        config = dataclasses.replace(
+            preset("smoke", mode="planner"),
+            env=env,
+            condition_refresh_every=1,
+            condition_refresh_sensitivity=sensitivity,
+        )
+        verdicts = VerdictData(config, seed=0)
+        verdicts.add(guides, last_valid)
+        _, info = verdicts.refresh(field)
+        thresholds.append(info["threshold"])
+    assert used == [FitConfig().target_sensitivity, 1.0]
+    assert thresholds[1] <= thresholds[0]
+    with pytest.raises(UsageError, match="condition_refresh_sensitivity"):
+        dataclasses.replace(preset("smoke", mode="planner"), condition_refresh_sensitivity=1.5).validate()

@@ -118,6 +118,12 @@ class TrainConfig:
     # (200 Adam steps, a few seconds on 2 cores) small against the validation's minute.
     condition_refresh_every: int = 0
     condition_refresh_min_poses: int = 400
+    # The share of the feasible poses held aside that a refit keeps feasible when it sets its
+    # threshold (`FitConfig.target_sensitivity`); None: FitConfig's, 0.95. The poses held aside
+    # are the policy's own guide poses, so 0.95 rejects about 1 in 20 of the poses the policy
+    # visits: refitted so, the condition ended 59-86 % of the training episodes and the policy
+    # stopped (docs/results/2026-12-03-ablation).
+    condition_refresh_sensitivity: float | None = None
     # Poses drawn as resets are and labelled by the condition the run starts with, fitted with
     # the verdicts at every refit (`VerdictData`); 0: the verdicts alone. Refitted on the
     # verdicts alone, the condition forgot the stairs the policy's guides avoid: it rejected
@@ -169,6 +175,11 @@ class TrainConfig:
         if self.condition_anchor_poses < 0:
             raise UsageError(
                 f"TrainConfig.condition_anchor_poses must be >= 0, got {self.condition_anchor_poses!r}"
+            )
+        if self.condition_refresh_sensitivity is not None and not 0 < self.condition_refresh_sensitivity <= 1:
+            raise UsageError(
+                "TrainConfig.condition_refresh_sensitivity must be in (0, 1] or None, "
+                f"got {self.condition_refresh_sensitivity!r}"
             )
         if self.condition_refresh_every < 0:
             raise UsageError(

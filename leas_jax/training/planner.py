@@ -17,6 +17,7 @@ importance ratio (clipped at 1 ± epsilon) absorbs.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import jax
@@ -417,7 +418,12 @@ class VerdictData:
         poses = np.concatenate([self.anchor_poses, self.seed_poses, self.poses])
         labels = np.concatenate([self.anchor_labels, self.seed_labels, self.labels])
         x = features_of(field.condition, field, poses, reach)
-        params, info = fit(x, labels, FitConfig(seed=self.refreshes), init=field.condition, reach=reach)
+        fit_config = FitConfig(seed=self.refreshes)
+        if self.config.condition_refresh_sensitivity is not None:
+            fit_config = dataclasses.replace(
+                fit_config, target_sensitivity=self.config.condition_refresh_sensitivity
+            )
+        params, info = fit(x, labels, fit_config, init=field.condition, reach=reach)
         self.refreshes += 1
         return field.replace(condition=params), info
 

@@ -127,7 +127,6 @@ def add_training_arguments(parser) -> None:
 
 def config_from_args(args):
     """TrainConfig of the parsed `leas train` / `leas run` arguments."""
-
     overrides = {}
     if args.init is not None:
         if args.mode != "planner":

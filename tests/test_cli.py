@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from leas_jax.cli import main
+from leas_jax.errors import UsageError
 
 ARENA = "terrains/training_arena.toml"
 
@@ -137,6 +138,26 @@ def test_train_with_the_calibrated_reachability_condition(tmp_path, capsys):
     # the default: the same command line without the option, up to the config it trains
     default = config_from_args(build_parser().parse_args(["train", *small, "--out", str(tmp_path / "p")]))
     assert default.env.reachability == TRAINING_REACHABILITY
+
+
+def test_train_sets_the_gradient_steps_per_epoch(tmp_path, capsys):
+    """`--num-minibatches N` sets TrainConfig.num_minibatches in either mode (the preset's
+    otherwise); one that does not divide the envs is one UsageError, zero is refused by argparse."""
+    from leas_jax.cli import build_parser
+    from leas_jax.training.commands import config_from_args
+    from leas_jax.training.config import PLANNER_PRESETS
+
+    parser = build_parser()
+    base = ["train", "--preset", "paper", "--out", str(tmp_path / "r")]
+    planner = config_from_args(parser.parse_args([*base, "--mode", "planner", "--num-minibatches", "64"]))
+    assert planner.num_minibatches == 64 and planner.num_envs == 64
+    default = config_from_args(parser.parse_args([*base, "--mode", "planner"]))
+    assert default.num_minibatches == PLANNER_PRESETS["paper"]["num_minibatches"]
+    with pytest.raises(UsageError, match="num_minibatches \\(48\\)"):
+        config_from_args(parser.parse_args([*base, "--mode", "planner", "--num-minibatches", "48"]))
+    with pytest.raises(SystemExit):
+        parser.parse_args([*base, "--num-minibatches", "0"])
+    assert "--num-minibatches" in capsys.readouterr().err
 
 
 def test_console_script_runs():

@@ -66,6 +66,14 @@ def add_training_arguments(parser) -> None:
         "--num-envs", type=positive_int, default=None, help="override the number of parallel envs"
     )
     parser.add_argument(
+        "--num-minibatches",
+        type=positive_int,
+        metavar="N",
+        default=None,
+        help="override the preset's gradient steps per epoch: each PPO epoch splits the batch's "
+        "envs (planner mode: episodes) into N parts; must divide the number of envs",
+    )
+    parser.add_argument(
         "--reachability",
         choices=["presets", "calibrated", "learned"],
         default="presets",
@@ -146,6 +154,8 @@ def config_from_args(args):
         overrides["num_timesteps"] = args.timesteps
     if args.num_envs is not None:
         overrides["num_envs"] = args.num_envs
+    if args.num_minibatches is not None:
+        overrides["num_minibatches"] = args.num_minibatches
     if args.checkpoint_every is not None:
         overrides["checkpoint_every_s"] = args.checkpoint_every
     config = preset(args.preset, mode=args.mode, **overrides)

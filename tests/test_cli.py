@@ -160,6 +160,24 @@ def test_train_sets_the_gradient_steps_per_epoch(tmp_path, capsys):
     assert "--num-minibatches" in capsys.readouterr().err
 
 
+def test_train_summary_of_a_run_with_nothing_left_to_train(tmp_path):
+    """`leas train`'s last line gives the speed of what it trained, and says "already trained"
+    (not "nan steps/s") when a resumed run had nothing left to train."""
+    from leas_jax.training.commands import training_summary
+    from leas_jax.training.loop import TrainResult
+
+    def result(metrics):
+        return TrainResult(tmp_path, tmp_path / "policy.ckpt", 1_214_793, 5.2, metrics)
+
+    assert training_summary(result({"sps": 801.9})) == (
+        f"trained 1,214,793 env steps in 5 s (802 steps/s); policy: {tmp_path / 'policy.ckpt'}"
+    )
+    assert (
+        training_summary(result({}))
+        == f"already trained: 1,214,793 env steps; policy: {tmp_path / 'policy.ckpt'}"
+    )
+
+
 def test_console_script_runs():
     """The installed `leas` entry point answers --help without importing JAX errors."""
     result = subprocess.run([sys.executable, "-m", "leas_jax.cli", "--help"], capture_output=True, text=True)

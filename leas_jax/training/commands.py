@@ -216,12 +216,19 @@ def cmd_train(args) -> int:
         address=args.ray_address,
         allow_pickle=args.allow_pickle,
     )
-    metrics = result.metrics
-    print(
-        f"trained {result.env_steps:,} env steps in {result.wall_s:.0f} s "
-        f"({metrics.get('sps', float('nan')):,.0f} steps/s); policy: {result.policy_path}"
-    )
+    print(training_summary(result))
     return 0
+
+
+def training_summary(result) -> str:
+    """The line `leas train` ends with; a resumed run that had nothing left to train says so
+    (its call logged no iteration, so there is no speed to report)."""
+    if "sps" not in result.metrics:
+        return f"already trained: {result.env_steps:,} env steps; policy: {result.policy_path}"
+    return (
+        f"trained {result.env_steps:,} env steps in {result.wall_s:.0f} s "
+        f"({result.metrics['sps']:,.0f} steps/s); policy: {result.policy_path}"
+    )
 
 
 def cmd_convert(args) -> int:

@@ -273,7 +273,12 @@ PRESETS = {
 # `smoke` trains from scratch. The learning rate decays linearly to 0 over the
 # kept steps (Stable Baselines' PPO1 default, as in the geometric presets); a
 # constant 5e-4 made a 500 k-step fine-tuning worse than a 150 k-step one
-# (docs/results/2026-11-22-make-run-planner-500k).
+# (docs/results/2026-11-22-make-run-planner-500k). Neither more samples nor more gradient
+# steps made the phase help on the current generator (docs/results/2026-12-03-planner-phase-
+# settings, 3 seeds): 1.2 M kept steps covered 88.7 % of the policy's own arena guides against
+# 88.8 % after 150 k; 64 mini-batches per epoch (the paper's count is 256 of 48 steps) covered
+# 88.9 % but slowed the policy from 3.3 to 2.2-2.8 m per episode. Hence 4 mini-batches, and
+# budgets sized by wall time rather than by a measured gain.
 PLANNER_PRESETS = {
     "smoke": dict(num_timesteps=20_000, num_envs=16, num_minibatches=2, num_epochs=4),
     "quick": dict(

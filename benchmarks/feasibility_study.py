@@ -24,6 +24,7 @@ generator covers fully, their mean coverage and the mean progress along the targ
 
     python benchmarks/feasibility_study.py --out DIR [--seeds 0,1,2] [--geometric-steps N]
         [--planner-steps N] [--starts 256] [--eval-seeds 0,1] [--scenarios eval_stairs ...]
+        [--clearance-condition condition|cylinders]
 
 Writes DIR/feasibility_study.json, feasibility_study.md and feasibility_study.png; training
 runs go to DIR/runs/<method>/seed<k>: a finished run is reused, and so is its evaluation
@@ -84,7 +85,9 @@ def method_configs(method: str, seed: int, args):
     env = PRESETS[args.preset].get("env", TRAINING_ENV)  # the preset's env: `quick` adds the clearance term
     if method.startswith("learned"):
         env = learned_condition_env(env, args.weights)
-    env = dataclasses.replace(env, episode_length=args.episode_length)
+    env = dataclasses.replace(
+        env, episode_length=args.episode_length, clearance_condition=args.clearance_condition
+    )
     geo = preset(
         args.preset,
         num_timesteps=args.geometric_steps,
@@ -392,6 +395,7 @@ def _parse_ints(name: str, text: str) -> tuple[int, ...]:
 def main(argv=None) -> dict:
     from common import machine
 
+    from leas_jax.env.config import CLEARANCE_CONDITIONS
     from leas_jax.errors import UsageError
     from leas_jax.training.config import PLANNER_PRESETS, PRESETS
 
@@ -425,6 +429,12 @@ def main(argv=None) -> dict:
         "(TrainConfig.condition_refresh_sensitivity; default FitConfig's 0.95)",
     )
     parser.add_argument("--weights", default="checkpoints/feasibility/walking.npz")
+    parser.add_argument(
+        "--clearance-condition",
+        choices=CLEARANCE_CONDITIONS,
+        default="condition",
+        help="what judges the clearance term's probe poses (EnvConfig.clearance_condition)",
+    )
     parser.add_argument("--starts", type=int, default=256, help="arena starts per evaluation seed")
     parser.add_argument("--eval-seeds", default="0,1")
     parser.add_argument("--ground-starts", type=int, default=256)

@@ -1,13 +1,15 @@
 """Geometric PPO throughput (env steps per second, learning included).
 
 For each preset and termination condition (`--conditions`: the presets' cylinders,
-the learned network of `EnvConfig(condition="learned")`), and optional overrides,
-compiles one training call, then times `--calls` calls. The bare reference env (`benchmarks/reference_env.py`) is
+the learned network of `EnvConfig(condition="learned")`), each judge of the clearance
+term's probe poses (`--clearance-conditions`, learned condition only: the network itself or
+the cylinders, `EnvConfig.clearance_condition`), and optional overrides, compiles one training call, then times `--calls` calls. The bare reference env (`benchmarks/reference_env.py`) is
 timed at the preset's batch right before and after, and the training rate is also
 given as a ratio to the reference's (the mean of the two), which the machine's
 load moves less than env steps/s. Writes <out>/train_throughput.json.
 
-    python benchmarks/train_throughput.py [--presets quick,paper] [--conditions cylinders,learned] [--calls 5]
+    python benchmarks/train_throughput.py [--presets quick,paper] [--conditions cylinders,learned]
+        [--clearance-conditions condition,cylinders] [--calls 5]
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ def measure(config, field, calls: int) -> dict:
     return {
         "preset": config.preset,
         "condition": config.env.condition,
+        "clearance_condition": config.env.clearance_condition,
         "num_envs": config.num_envs,
         "unroll_length": config.unroll_length,
         "num_minibatches": config.num_minibatches,
@@ -66,16 +69,41 @@ def measure(config, field, calls: int) -> dict:
     }
 
 
+def variants(name: str, conditions: list[str], judges: list[str], epochs: list[int]):
+    """(label, [TrainConfig]) per condition and clearance-probe judge of preset `name`: the
+    preset's config, then one per `epochs` value. The judges apply to the learned condition
+    where the preset has a clearance term (elsewhere the probes are not evaluated)."""
+    from leas_jax.training.config import learned_condition_env, preset
+
+    for condition in conditions:
+        base = [preset(name)] + [preset(name, num_epochs=e) for e in epochs]
+        if condition == "cylinders":
+            yield condition, base
+            continue
+        probed = base[0].env.rewards.clearance != 0.0
+        for judge in judges if probed else [judges[0]]:
+            env = dataclasses.replace(learned_condition_env(base[0].env), clearance_condition=judge)
+            yield (
+                (f"learned (probes: {judge})" if probed else "learned"),
+                [dataclasses.replace(c, env=env) for c in base],
+            )
+
+
 def main() -> None:
     from leas_jax.env import heightfield_from_terrain
+    from leas_jax.env.config import CLEARANCE_CONDITIONS
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import learned_condition_env, preset
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--presets", default="quick,paper")
     parser.add_argument("--calls", type=int, default=5)
     parser.add_argument("--epochs", default="", help="also measure these num_epochs values, e.g. 10,4")
     parser.add_argument("--conditions", default="cylinders", help="comma-separated: cylinders, learned")
+    parser.add_argument(
+        "--clearance-conditions",
+        default="condition",
+        help="comma-separated judges of the learned condition's clearance probes: condition, cylinders",
+    )
     add_out_argument(parser)
     args = parser.parse_args()
     load_before = load_average()
@@ -85,17 +113,22 @@ def main() -> None:
         parser.error(
             f"--conditions: expected a comma-separated subset of cylinders,learned, got {args.conditions!r}"
         )
+    judges = [c for c in args.clearance_conditions.split(",") if c]
+    if not judges or set(judges) - set(CLEARANCE_CONDITIONS):
+        parser.error(
+            f"--clearance-conditions: expected a comma-separated subset of {','.join(CLEARANCE_CONDITIONS)}, "
+            f"got {args.clearance_conditions!r}"
+        )
     for name in args.presets.split(","):
-        for condition in conditions:
-            configs = [preset(name)] + [preset(name, num_epochs=int(e)) for e in args.epochs.split(",") if e]
-            if condition == "learned":
-                configs = [dataclasses.replace(c, env=learned_condition_env(c.env)) for c in configs]
+        for label, configs in variants(
+            name, conditions, judges, [int(e) for e in args.epochs.split(",") if e]
+        ):
             field = heightfield_from_terrain(load_terrain(configs[0].terrain_path()), configs[0].env)
             for variant in configs:
                 row = measure(variant, field, args.calls)
                 rows.append(row)
                 print(
-                    f"{name:6s} {condition:9s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
+                    f"{name:6s} {label:28s} epochs {variant.num_epochs:2d} minibatches {variant.num_minibatches:2d}: "
                     f"{row['env_steps_per_s']:>10,} env steps/s ({row['ratio_to_reference']:.3f} of the reference env's), "
                     f"80 M steps in {row['minutes_for_80M_steps']} min "
                     f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "

@@ -287,3 +287,24 @@ def test_contact_worker_startup_times_each_stage_against_a_reference(tmp_path):
     assert set(saved["ratio_this_to_reference"]) == {*startup.STAGES, "total"}
     with pytest.raises(SystemExit):
         startup.main(["--reference", str(tmp_path)])  # not a checkout
+
+
+def test_train_throughput_varies_the_clearance_probes_judge_where_probes_are_evaluated():
+    """benchmarks/train_throughput.py's variants: the learned condition once per judge of the
+    clearance probes where the preset has a clearance term (`quick`), once where it has none
+    (`paper`); the cylinders once; each with its --epochs variants."""
+    import train_throughput
+
+    judges = ["condition", "cylinders"]
+    quick = list(train_throughput.variants("quick", ["cylinders", "learned"], judges, [10]))
+    assert [label for label, _ in quick] == [
+        "cylinders",
+        "learned (probes: condition)",
+        "learned (probes: cylinders)",
+    ]
+    for (_, configs), judge in zip(quick[1:], judges, strict=True):
+        assert [c.num_epochs for c in configs] == [3, 10]
+        assert {(c.env.condition, c.env.clearance_condition) for c in configs} == {("learned", judge)}
+    paper = list(train_throughput.variants("paper", ["cylinders", "learned"], judges, []))
+    assert [label for label, _ in paper] == ["cylinders", "learned"]
+    assert paper[0][1][0].env.condition == "cylinders" and paper[1][1][0].env.condition == "learned"

@@ -295,3 +295,36 @@ def test_feasibility_condition_benchmark_runs_end_to_end(tmp_path, monkeypatch):
     params, metadata = lf.load_params(weights)
     assert metadata["data_key"] == saved["data_key"]
     assert "| fresh |" in (report / "feasibility_condition.md").read_text()
+
+
+def test_clearance_probes_are_judged_by_the_selected_condition(tmp_path):
+    """EnvConfig.clearance_condition: "condition" judges the clearance term's six probes with the
+    termination condition (a network that rejects everything: all six fail), "cylinders" with
+    the env's cylinders whatever the condition (the same shortfall as `reachability`'s: 0 for
+    some poses, a fraction for others); another value is refused naming the field."""
+    from leas_jax.errors import UsageError
+    from leas_jax.training.config import preset
+
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=reach)
+    reject = lf.save_params(tmp_path / "reject.npz", {**params, "threshold": jnp.asarray(1e9)})
+    learned = dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(reject))
+    field = heightfield_from_terrain(WALL, learned)
+    poses = jnp.asarray(_poses(64, seed=3), jnp.float32)
+
+    def shortfall(config):
+        return np.asarray(
+            jax.jit(jax.vmap(lambda p: condition.clearance_shortfall(field, p, 0.1, config)))(poses)
+        )
+
+    np.testing.assert_array_equal(shortfall(learned), 1.0)
+    cylinders = shortfall(dataclasses.replace(learned, clearance_condition="cylinders"))
+    expected = np.asarray(jax.vmap(lambda p: reachability.clearance_shortfall(field, p, 0.1, reach))(poses))
+    np.testing.assert_array_equal(cylinders, expected)
+    assert (cylinders == 0.0).any() and ((cylinders > 0.0) & (cylinders < 1.0)).any()
+    with pytest.raises(ValueError, match="clearance_condition must be one of condition, cylinders"):
+        condition.clearance_shortfall(
+            field, poses[0], 0.1, dataclasses.replace(learned, clearance_condition="x")
+        )
+    with pytest.raises(UsageError, match="env.clearance_condition"):
+        preset("smoke", env=dataclasses.replace(TRAINING_ENV, clearance_condition="network"))

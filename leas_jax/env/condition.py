@@ -9,7 +9,7 @@ contact generator's walking verdicts, whose parameters the heightfield carries
 import jax
 
 from leas_jax.env import learned_feasibility, reachability
-from leas_jax.env.config import EnvConfig
+from leas_jax.env.config import CLEARANCE_CONDITIONS, EnvConfig
 from leas_jax.env.field import Heightfield
 
 CONDITIONS = ("cylinders", "learned")
@@ -32,7 +32,15 @@ def valid(field: Heightfield, pose: jax.Array, config: EnvConfig) -> jax.Array:
 
 
 def clearance_shortfall(field: Heightfield, pose: jax.Array, margin: float, config: EnvConfig) -> jax.Array:
-    """`reachability.clearance_shortfall` under the selected condition: the fraction of the six
-    poses shifted by `margin` (m) along the root frame's axes that fail it. pose: [4] -> float[]."""
+    """`reachability.clearance_shortfall` under `config.clearance_condition`: the fraction of the
+    six poses shifted by `margin` (m) along the root frame's axes that fail the selected
+    condition ("condition": the env's own, "cylinders": its cylinders). pose: [4] -> float[]."""
+    if config.clearance_condition == "cylinders":
+        return reachability.clearance_shortfall(field, pose, margin, config.reachability)
+    if config.clearance_condition != "condition":
+        raise ValueError(
+            f"EnvConfig.clearance_condition must be one of {', '.join(CLEARANCE_CONDITIONS)}, "
+            f"got {config.clearance_condition!r}"
+        )
     probes = reachability.shifted_poses(pose, margin)
     return 1.0 - jax.vmap(lambda probe: valid(field, probe, config))(probes).mean()

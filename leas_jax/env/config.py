@@ -115,6 +115,9 @@ class RewardWeights:
     clearance: float = 0.0
 
 
+CLEARANCE_CONDITIONS = ("condition", "cylinders")  # values of EnvConfig.clearance_condition
+
+
 @dataclass(frozen=True)
 class EnvConfig:
     """LeaS MDP parameters (docs/design.md §5)."""
@@ -147,6 +150,12 @@ class EnvConfig:
     # gave 89.1 % once and 0.12 m slowed them to 0.13 m/s (docs/results/INDEX.md,
     # "The clearance term")
     clearance_margin: float = 0.10
+    # What judges the clearance term's six probe poses: "condition", the termination
+    # condition itself (`condition`), or "cylinders", the cylinders of `reachability` whatever
+    # the condition. Under the learned condition the probes are six more network evaluations
+    # per step: they made the `quick` env step 5.5 x dearer (0.94 us per probe, 2 cores;
+    # docs/results/2026-12-04-learned-clearance); the cylinders judge them for 0.01 us each.
+    clearance_condition: str = "condition"
     reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
     # Where resets start (issue 19): "condition", near grid points where `condition`'s
     # cylinders hold for every yaw (the paper's resets), or "generator", at poses where the

@@ -26,7 +26,13 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from leas_jax.env.config import EnvConfig, HeightmapConfig, ReachabilityConfig, RewardWeights
+from leas_jax.env.config import (
+    CLEARANCE_CONDITIONS,
+    EnvConfig,
+    HeightmapConfig,
+    ReachabilityConfig,
+    RewardWeights,
+)
 from leas_jax.errors import UsageError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -201,6 +207,11 @@ class TrainConfig:
             raise UsageError(
                 f"TrainConfig.pretrain must be '' or a geometric preset ({', '.join(PRESETS)}), "
                 f"got {self.pretrain!r}"
+            )
+        if self.env.clearance_condition not in CLEARANCE_CONDITIONS:
+            raise UsageError(
+                f"TrainConfig.env.clearance_condition must be one of {', '.join(CLEARANCE_CONDITIONS)}, "
+                f"got {self.env.clearance_condition!r}"
             )
         if self.num_envs % self.num_minibatches:
             raise UsageError(

@@ -328,3 +328,41 @@ def test_clearance_probes_are_judged_by_the_selected_condition(tmp_path):
         )
     with pytest.raises(UsageError, match="env.clearance_condition"):
         preset("smoke", env=dataclasses.replace(TRAINING_ENV, clearance_condition="network"))
+
+
+def test_train_command_sets_the_clearance_probes_judge():
+    """`--clearance-condition` sets EnvConfig.clearance_condition of a learned-condition preset
+    with the clearance term (both modes: `leas run` passes it to both phases); without it the
+    network judges; it is refused with the cylinders, a preset without the term, or another value."""
+    from leas_jax.cli import build_parser
+    from leas_jax.errors import UsageError
+    from leas_jax.training.commands import config_from_args
+
+    parser = build_parser()
+    learned = ["train", "--out", "r", "--preset", "quick", "--reachability", "learned"]
+    assert config_from_args(parser.parse_args(learned)).env.clearance_condition == "condition"
+    for mode in ("geometric", "planner"):
+        config = config_from_args(
+            parser.parse_args([*learned, "--mode", mode, "--clearance-condition", "cylinders"])
+        )
+        assert config.env.condition == "learned" and config.env.clearance_condition == "cylinders"
+    with pytest.raises(UsageError, match="--clearance-condition is for --reachability learned"):
+        config_from_args(parser.parse_args(["train", "--out", "r", "--clearance-condition", "cylinders"]))
+    with pytest.raises(UsageError, match="preset 'paper' has no clearance term"):
+        config_from_args(
+            parser.parse_args(
+                [
+                    "train",
+                    "--out",
+                    "r",
+                    "--preset",
+                    "paper",
+                    "--reachability",
+                    "learned",
+                    "--clearance-condition",
+                    "cylinders",
+                ]
+            )
+        )
+    with pytest.raises(SystemExit):
+        parser.parse_args([*learned, "--clearance-condition", "network"])

@@ -12,6 +12,7 @@ from leas_jax.arguments import (
     non_negative_seconds,
     positive_int,
 )
+from leas_jax.env.config import CLEARANCE_CONDITIONS
 from leas_jax.errors import UsageError
 from leas_jax.training.config import LEARNED_REFRESH_EVERY, PRESETS, learned_condition_env, preset
 
@@ -92,6 +93,15 @@ def add_training_arguments(parser) -> None:
         help="with --reachability learned: the learned condition's weights (default "
         "checkpoints/feasibility/walking.npz; benchmarks/condition_from_paths.py refits them on the "
         "generator's whole-path verdicts)",
+    )
+    parser.add_argument(
+        "--clearance-condition",
+        choices=CLEARANCE_CONDITIONS,
+        default=None,
+        help="with --reachability learned and a preset with the clearance term (quick): what judges "
+        "the term's six probe poses, the network itself (condition, the default) or the calibrated "
+        "cylinders (cylinders: six cylinder checks per step instead of six network evaluations; "
+        "docs/results/2026-12-04-learned-clearance)",
     )
     parser.add_argument(
         "--condition-seed-data",
@@ -185,6 +195,14 @@ def config_from_args(args):
             )
         config = dataclasses.replace(
             config, env=learned_condition_env(config.env, weights), condition_refresh_every=refresh
+        )
+    if args.clearance_condition is not None:
+        if args.reachability != "learned":
+            raise UsageError("--clearance-condition is for --reachability learned")
+        if config.env.rewards.clearance == 0.0:
+            raise UsageError(f"--clearance-condition: preset {args.preset!r} has no clearance term")
+        config = dataclasses.replace(
+            config, env=dataclasses.replace(config.env, clearance_condition=args.clearance_condition)
         )
     if args.condition_refresh_every is not None and (
         args.reachability != "learned" or config.mode != "planner"

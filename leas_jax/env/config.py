@@ -153,8 +153,10 @@ class EnvConfig:
     # What judges the clearance term's six probe poses: "condition", the termination
     # condition itself (`condition`), or "cylinders", the cylinders of `reachability` whatever
     # the condition. Under the learned condition the probes are six more network evaluations
-    # per step: they made the `quick` env step 5.5 x dearer (0.94 us per probe, 2 cores;
-    # docs/results/2026-12-04-learned-clearance); the cylinders judge them for 0.01 us each.
+    # per step: `quick` training then costs 2.3-2.7 x the cylinders' per env step, 1.5 x with
+    # the cylinders judging the probes; but so trained, no policy crossed eval_bridge (40 %
+    # judged by the network) and one seed of three stopped at 0.07 m/s (2 cores, 3 seeds;
+    # docs/results/2026-12-04-learned-clearance). Hence the network by default.
     clearance_condition: str = "condition"
     reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
     # Where resets start (issue 19): "condition", near grid points where `condition`'s

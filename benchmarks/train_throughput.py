@@ -3,10 +3,11 @@
 For each preset and termination condition (`--conditions`: the presets' cylinders,
 the learned network of `EnvConfig(condition="learned")`), each judge of the clearance
 term's probe poses (`--clearance-conditions`, learned condition only: the network itself or
-the cylinders, `EnvConfig.clearance_condition`), and optional overrides, compiles one training call, then times `--calls` calls. The bare reference env (`benchmarks/reference_env.py`) is
-timed at the preset's batch right before and after, and the training rate is also
-given as a ratio to the reference's (the mean of the two), which the machine's
-load moves less than env steps/s. Writes <out>/train_throughput.json.
+the cylinders, `EnvConfig.clearance_condition`), and optional overrides, compiles one
+training call, then times `--calls` calls. The bare reference env
+(`benchmarks/reference_env.py`) is timed at the preset's batch right before and after, and
+the training rate is also given as a ratio to the reference's (the mean of the two), which
+the machine's load moves less than env steps/s. Writes <out>/train_throughput.json.
 
     python benchmarks/train_throughput.py [--presets quick,paper] [--conditions cylinders,learned]
         [--clearance-conditions condition,cylinders] [--calls 5]

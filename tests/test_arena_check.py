@@ -1,5 +1,6 @@
 """`leas arena-check`: arena safety of a policy and the breakdown of its invalid episodes."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -7,7 +8,13 @@ import pytest
 
 from leas_jax.cli import main
 from leas_jax.env import heightfield_from_terrain
-from leas_jax.eval.geometric import arena_episodes, bearing_sector, failure_breakdown, reachability_terms
+from leas_jax.eval.geometric import (
+    NO_CYLINDER_TERM,
+    arena_episodes,
+    bearing_sector,
+    failure_breakdown,
+    reachability_terms,
+)
 from leas_jax.terrain import load_terrain
 from leas_jax.training import load_policy
 
@@ -67,6 +74,18 @@ def test_breakdown_counts_every_invalid_episode_once(episodes_of_a_tiny_policy):
     trunk = sum(count for label, count in breakdown.terms.items() if "trunk_free" in label.split("+"))
     assert sum(breakdown.trunk_bearing.values()) == trunk
     assert breakdown.speed_quartiles == sorted(breakdown.speed_quartiles)
+
+
+def test_an_invalid_pose_that_every_cylinder_term_accepts_is_named_so(episodes_of_a_tiny_policy):
+    """The learned condition ends episodes where the cylinders hold: the breakdown says so."""
+    policy, field, episodes = episodes_of_a_tiny_policy
+    first = np.flatnonzero(~np.isnan(episodes.failure_poses[:, 0]))[0]
+    failure_poses = episodes.failure_poses.copy()
+    failure_poses[first] = episodes.poses[first, episodes.lengths[first] - 1]  # its last valid pose
+    relabelled = dataclasses.replace(episodes, failure_poses=failure_poses)
+    breakdown = failure_breakdown(field, relabelled, policy.config.env.reachability)
+    assert breakdown.terms[NO_CYLINDER_TERM] == 1
+    assert NO_CYLINDER_TERM not in failure_breakdown(field, episodes, policy.config.env.reachability).terms
 
 
 def test_arena_check_writes_its_outputs(run_dir, tmp_path, capsys):

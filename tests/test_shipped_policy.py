@@ -1,15 +1,17 @@
-"""The shipped policy `checkpoints/leas_talos/`: small, trained by the project's own preset, and it walks.
+"""The shipped policy `checkpoints/leas_talos/`: small, trained by the project's own preset with the
+learned condition, and it walks.
 
 If a default of the environment or of the presets changes, its config no longer
 equals the preset's and this fails: retrain it with the README's command.
 """
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
 
 from leas_jax.training import load_policy, preset
-from leas_jax.training.config import REPO_ROOT, pretraining_config
+from leas_jax.training.config import REPO_ROOT, learned_condition_env, pretraining_config
 
 SHIPPED = REPO_ROOT / "checkpoints" / "leas_talos"
 
@@ -18,10 +20,13 @@ def _size(path: Path) -> int:
     return sum(f.stat().st_size for f in path.rglob("*") if f.is_file())
 
 
-def test_shipped_policy_is_small_and_from_the_paper_preset():
+def test_shipped_policy_is_small_and_from_the_paper_preset_with_the_learned_condition():
     assert _size(SHIPPED) < 5 * 2**20
     policy = load_policy(SHIPPED)
-    assert policy.config == preset("paper", mode="planner")
+    paper = preset("paper", mode="planner")
+    # `leas train --mode planner --preset paper --reachability learned --condition-refresh-every 0`
+    assert policy.config == dataclasses.replace(paper, env=learned_condition_env(paper.env))
+    assert policy.config.condition_refresh_every == 0
     assert policy.env_steps >= policy.config.num_timesteps
     pretrained = load_policy(SHIPPED / "pretrain")
     assert pretrained.config == pretraining_config(policy.config)

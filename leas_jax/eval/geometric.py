@@ -189,8 +189,14 @@ def reachability_terms(field: Heightfield, poses: np.ndarray, config) -> dict:
     return jax.device_get(_terms_at(field, jnp.asarray(poses, jnp.float32), config))
 
 
+# The label of an invalid pose at which every term of the cylinders holds: a policy trained with
+# the learned condition (`EnvConfig.condition`) ends there because the network alone rejects it.
+NO_CYLINDER_TERM = "no cylinder term"
+
+
 def failure_breakdown(field: Heightfield, episodes: ArenaEpisodes, config) -> FailureBreakdown:
-    """Classify the invalid episodes of `episodes` (host; the terms are evaluated jitted).
+    """Classify the invalid episodes of `episodes` (host; the terms are evaluated jitted): by the
+    terms of `config`'s cylinders that fail at the first invalid pose (`NO_CYLINDER_TERM` if none).
 
     Args:
         field: the heightfield the episodes ran on (built with `config`'s radii).
@@ -202,7 +208,10 @@ def failure_breakdown(field: Heightfield, episodes: ArenaEpisodes, config) -> Fa
     if len(failed) == 0:
         return FailureBreakdown(0, {}, {}, {}, [], [])
     terms = reachability_terms(field, episodes.failure_poses[failed], config)
-    labels = ["+".join(name for name, ok in terms.items() if not ok[k]) or "none" for k in range(len(failed))]
+    labels = [
+        "+".join(name for name, ok in terms.items() if not ok[k]) or NO_CYLINDER_TERM
+        for k in range(len(failed))
+    ]
     # Offending terrain of a trunk failure: polar samples of the trunk disk above its bottom.
     # (the raster of the condition takes the disk on the grid: reach one cell beyond the radius)
     radius = np.linspace(0.0, config.trunk_radius + float(field.resolution), 17)[1:]

@@ -613,34 +613,6 @@ def test_a_stuck_plan_goes_back_and_retries_with_other_step_settings():
     assert verify(plan).ok
 
 
-def _without_last_retries(count: int) -> GeneratorConfig:
-    """The default generator without the last `count` entries of its `retry_settings`."""
-    retries = GeneratorConfig().retry_settings
-    return GeneratorConfig(retry_settings=retries[: len(retries) - count])
-
-
-def test_a_climb_passes_with_the_foot_lifted_a_riser_high():
-    """The shipped policy's guide climbing the arena's stairs at 0.13 m/s: with the retries
-    before the 0.15 m swing lift the plan stops at guide pose 90; lifting the foot a riser
-    high clears the next tread, and the plan is covered and verifies."""
-    guide, timestep = _arena_guide("stairs_up_high_swing")
-    assert plan_contacts(_arena(), guide, timestep, _without_last_retries(2)).last_valid_index == 90
-    plan = plan_contacts(_arena(), guide, timestep, _without_last_retries(1))
-    assert plan.coverage == 1.0
-    assert verify(plan).ok
-
-
-def test_a_step_aimed_further_ahead_passes_onto_a_platform():
-    """The shipped policy's guide onto one of the arena's step platforms: every retry up to
-    the swing lift leaves it stopped at guide pose 31; steps aimed 1.1 s ahead cover it."""
-    guide, timestep = _arena_guide("step_platform_far_lookahead")
-    assert plan_contacts(_arena(), guide, timestep, _without_last_retries(1)).coverage < 1.0
-    assert plan_contacts(_arena(), guide, timestep, _without_last_retries(2)).last_valid_index == 31
-    plan = plan_contacts(_arena(), guide, timestep)
-    assert plan.coverage == 1.0
-    assert verify(plan).ok
-
-
 def test_a_wider_step_search_finds_the_tread_a_foot_can_take():
     """A shipped-policy guide climbing the arena's stairs: with candidates within 0.15 m of
     the step target and a 0.25 m comfort region the plan stops at guide pose 63; the 0.30 m

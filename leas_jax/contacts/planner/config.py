@@ -150,12 +150,6 @@ class GeneratorConfig:
     # (farther-ahead steps before a climb, a longer root shift over a far stance sole on
     # rubble); see docs/results/2026-12-02-retry-settings. Only the walking settings in
     # RETRY_FIELDS may change. () never retries.
-    # The last two, tried after the others, follow the policies' faster climbs: a foot lifted
-    # 0.15 m, a riser of the arena's stairs, clears the next tread's edge that a 5 cm lift
-    # meets, and a step aimed 1.1 s ahead keeps up with a root rising at 0.15-0.2 m/s. On the
-    # shipped policy's own arena guides they passed 9 of 27 and 16 of 32 failed guides
-    # (evaluation seeds 0 and 1, where they were chosen; seeds 2 and 3 held out:
-    # docs/results/2026-12-05-higher-swing-retries; test_a_climb_passes_with_the_foot_lifted_a_riser_high).
     retry_settings: tuple = (
         (("lookahead", 0.9),),
         (("candidate_radius", 0.40), ("max_candidates", 48)),
@@ -163,8 +157,6 @@ class GeneratorConfig:
         (("lookahead", 0.5),),
         (("step_trigger", 0.05),),
         (("swing_lift", 0.03),),
-        (("swing_lift", 0.15),),
-        (("lookahead", 1.1),),
     )
     retry_backtrack: int = 4  # planning poses re-planned before the one that failed (2 s)
 

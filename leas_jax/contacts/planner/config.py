@@ -121,6 +121,14 @@ class GeneratorConfig:
     )
     feet_gap: float = 0.01  # m, minimal gap between the two sole rectangles (see edge_margin)
     swing_lift: float = 0.05  # m, height of a foot in the air above its last contact
+    # m: where the terrain between a foot's last contact and its step target rises more than
+    # `swing_rise` above that contact (a stair's riser ahead), the foot in the air is held this
+    # high above the contact instead, clear of the riser its shin or toe meets at swing_lift.
+    # Only where it rises: held this high on flat ground, the feet also followed a 4 rad/s
+    # turn in place (test_turning_too_fast_stops) that the low swing's leg collisions stop;
+    # docs/results/2026-12-05-swing-lift-on-rise. None: swing_lift everywhere.
+    swing_lift_on_rise: float | None = None
+    swing_rise: float = 0.03  # m, 6 x cover_tol, under the arena's lowest riser
     swing_clearance: float = (
         0.05  # m, how far out of its hip a lifted foot may be held (walking.Walking.step)
     )
@@ -157,6 +165,8 @@ class GeneratorConfig:
         (("lookahead", 0.5),),
         (("step_trigger", 0.05),),
         (("swing_lift", 0.03),),
+        (("swing_lift_on_rise", 0.15),),
+        (("lookahead", 1.1),),
     )
     retry_backtrack: int = 4  # planning poses re-planned before the one that failed (2 s)
 
@@ -233,6 +243,8 @@ RETRY_FIELDS = frozenset(
         "candidate_radius",
         "max_candidates",
         "swing_lift",
+        "swing_lift_on_rise",
+        "swing_rise",
         "swing_clearance",
     }
 )

@@ -29,6 +29,7 @@ from leas_jax.contacts.robot.ik import leg_ik
 from leas_jax.contacts.robot.model import LEFT, RIGHT, SOLE_LENGTH, SOLE_WIDTH
 
 SCREEN_CHUNK = 6  # pool candidates screened at once (the cost is mostly per call)
+RISE_SAMPLING = 0.04  # m between terrain samples on a swing's path (`Footholds.rise`): 2 raster cells
 
 
 def _axis_difference(axis_yaw, yaw):
@@ -64,6 +65,19 @@ class Footholds:
         root_R = rotz(guide_pose[3])
         pos = np.asarray(guide_pose[:3], dtype=np.float64) + root_R @ self._nominal[side]
         return pos, float(guide_pose[3])
+
+    def rise(self, from_pos, to_pos) -> float:
+        """m, how far the terrain on the segment from_pos -> to_pos ([3] world; sampled every
+        `RISE_SAMPLING` m, both ends included, through a sole's half length beyond to_pos)
+        rises above from_pos: a stair riser or a block a foot swinging along it passes."""
+        start = np.asarray(from_pos[:2], dtype=np.float64)
+        delta = np.asarray(to_pos[:2], dtype=np.float64) - start
+        length = math.hypot(float(delta[0]), float(delta[1]))
+        reach = length + 0.5 * SOLE_LENGTH if length > 0.0 else 0.0
+        count = max(2, int(math.ceil(reach / RISE_SAMPLING)) + 1)
+        along = np.linspace(0.0, reach / max(length, 1e-12), count)
+        tops = height_at(self.terrain, start + along[:, None] * delta)
+        return float(tops.max() - from_pos[2])
 
     def candidates(self, side: int, guide_pose, target_pos, target_yaw: float, avoid=None):
         """Ranked sole placements for one foot near a target (vectorised).

@@ -102,13 +102,17 @@ class Walking:
         other = 1 - side
         stance = (other, feet[other][0], feet[other][1])
         old_pos, old_rot = feet[side]
-        lifted = [(old_pos + np.array([0.0, 0.0, cfg.swing_lift]), old_rot, False)]
+        ahead = guide[min(index + int(round(lookahead / timestep)), len(guide) - 1)]
+        target_pos, target_yaw = self.footholds.nominal_placement(ahead, side)
+        target_pos = self.footholds.beam_lane(side, target_pos, target_yaw)
+        lift = self._swing_lift(old_pos, target_pos)
+        lifted = [(old_pos + np.array([0.0, 0.0, lift]), old_rot, False)]
         # Or under its hip, swing_lift above its last contact (or above the half-sitting sole
         # height where that is higher, as on a step up). The half-sitting height alone put the
         # foot 12 cm underground under a root 0.85 m above the ground, where crouched walking
         # fails otherwise (the trailing foot cannot stay flat: ankle pitch < -1.31 rad).
         nominal_pos, _ = self.footholds.nominal_placement(pose, side)
-        nominal_pos[2] = max(nominal_pos[2], old_pos[2]) + cfg.swing_lift
+        nominal_pos[2] = max(nominal_pos[2], old_pos[2]) + lift
         lifted.append((nominal_pos, rotz(pose[3]), False))
         # Or swing_clearance farther out, following the root's shift toward the stance sole:
         # where that sole is nearer the guide's line than its nominal place, the stance
@@ -126,11 +130,17 @@ class Walking:
             single = self.projection.posture(pose, index, [stance], air=(side, lifted), com_target=nearer)
         if single is None:
             return None, False
-        ahead = guide[min(index + int(round(lookahead / timestep)), len(guide) - 1)]
-        target_pos, target_yaw = self.footholds.nominal_placement(ahead, side)
-        target_pos = self.footholds.beam_lane(side, target_pos, target_yaw)
         double, held_back = self._land(pose, index, feet, side, stance, target_pos, target_yaw, min_gain)
         return (None if double is None else [single, double]), held_back
+
+    def _swing_lift(self, old_pos, target_pos) -> float:
+        """m, how high above its last contact old_pos [3] a foot stepping toward target_pos
+        [3] (world) is held in the air: `swing_lift_on_rise` where the terrain between them
+        rises more than `swing_rise` above that contact (`Footholds.rise`), else `swing_lift`."""
+        cfg = self.config
+        if cfg.swing_lift_on_rise is not None and self.footholds.rise(old_pos, target_pos) > cfg.swing_rise:
+            return cfg.swing_lift_on_rise
+        return cfg.swing_lift
 
     def _land(
         self, pose, index: int, feet, side: int, stance, target_pos, target_yaw: float, min_gain

@@ -622,3 +622,33 @@ def test_a_wider_step_search_finds_the_tread_a_foot_can_take():
     plan = plan_contacts(_arena(), guide, timestep, GeneratorConfig(retry_settings=()))
     assert plan.coverage == 1.0
     assert verify(plan).ok
+
+
+def test_rise_is_the_terrain_a_swing_passes_above_the_foot():
+    """A 0.12 m step at x = 1.0: a foot at x = 0.7 stepping to x = 1.2 passes 0.12 m of
+    terrain above its sole; one stepping on the flat, or down from the step, passes none; a
+    target short of the riser still meets it within a sole's half length beyond."""
+    step = loads_terrain(HEAD + box([0, 0, -0.1], [2, 4, 0.2]) + box([3, 0, -0.04], [4, 4, 0.32]))
+    footholds = ContactGenerator(step).footholds
+    assert footholds.rise([0.7, 0.0, 0.0], [1.2, 0.0, 0.12]) == pytest.approx(0.12)
+    assert footholds.rise([0.2, 0.0, 0.0], [0.5, 0.1, 0.0]) == pytest.approx(0.0)
+    assert footholds.rise([1.5, 0.0, 0.12], [0.8, 0.0, 0.0]) == pytest.approx(0.0)
+    assert footholds.rise([0.6, 0.0, 0.0], [0.95, 0.0, 0.0]) == pytest.approx(0.12)
+    assert footholds.rise([0.3, 0.0, 0.0], [0.3, 0.0, 0.0]) == pytest.approx(0.0)
+
+
+def test_a_swing_held_high_over_a_rise_climbs_where_the_low_one_meets_the_riser():
+    """A shipped-policy guide climbing the arena's stairs at 0.10 m/s (its first 13 s):
+    with the 6 retries before `swing_lift_on_rise` the plan stops at guide pose 90, a leg
+    meeting the terrain; the retry holding the foot in the air 0.15 m above its last contact
+    where a riser is ahead covers it, and the plan verifies. On flat ground that retry is the
+    default settings again: `test_turning_too_fast_stops` still stops."""
+    guide, timestep = _arena_guide("stairs_up_swing_lift_on_rise")
+    base = GeneratorConfig()
+    without = tuple(r for r in base.retry_settings if dict(r).keys() != {"swing_lift_on_rise"})
+    assert len(without) == len(base.retry_settings) - 1
+    stopped = plan_contacts(_arena(), guide, timestep, dataclasses.replace(base, retry_settings=without))
+    assert stopped.last_valid_index == 90
+    plan = plan_contacts(_arena(), guide, timestep)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok

@@ -21,8 +21,9 @@ guide_failures.json and guide_failures.md into --out.
 `--set NAME=VALUE` (repeatable) changes one GeneratorConfig field for the run, e.g. the
 generator as it was before a change, to pair with it on other evaluation seeds.
 
-`--compare BEFORE AFTER` runs nothing: it pairs two reports of the same policy, starts,
-seed and spawns (so the same guides, deterministic episodes), e.g. before and after a
+`--compare BEFORE AFTER` runs nothing: it pairs two reports of the same policy (the same
+file digest, or the same path in reports without one), starts, seed and spawns (so the same
+guides, deterministic episodes), e.g. before and after a
 generator change, and writes <out>/paired.json: the guides one covers fully and the other
 does not ("fixed", "broken") and a two-sided sign test on those counts.
 
@@ -114,13 +115,30 @@ def sign_test(fixed: int, broken: int) -> float:
     return min(1.0, 2.0 * tail)
 
 
+def policy_digest(path) -> str:
+    """sha256 hex digest of the policy file of a run directory or policy file: the same
+    weights and config under another path (a run folder and the checkpoint copied from it)
+    give the same digest."""
+    import hashlib
+
+    from leas_jax.training.checkpoint import policy_file
+
+    return hashlib.sha256(Path(policy_file(Path(path))).read_bytes()).hexdigest()
+
+
 def paired(before: dict, after: dict) -> dict:
     """Guide-by-guide comparison of two reports of the same episodes (policy, starts, seed,
-    spawns): full coverage before and after, the guides fixed and broken, the sign test."""
+    spawns): full coverage before and after, the guides fixed and broken, the sign test.
+
+    The policy is the same when both reports hold the same `policy_sha256` (the file's
+    digest, `policy_digest`), else when they name the same path."""
     from leas_jax.errors import UsageError
 
     keys = ("policy", "starts", "seed", "spawns", "terrain")
-    differ = [k for k in keys if before.get(k) != after.get(k)]
+    same_weights = before.get("policy_sha256") is not None and before.get("policy_sha256") == after.get(
+        "policy_sha256"
+    )
+    differ = [k for k in keys if before.get(k) != after.get(k) and not (k == "policy" and same_weights)]
     if differ:
         raise UsageError(
             f"--compare: the reports differ in {', '.join(differ)}; only reports of the same episodes pair"
@@ -272,6 +290,7 @@ def main(argv=None) -> dict:
     moved = np.linalg.norm(final - start, axis=1)
     report = {
         "policy": str(args.policy),
+        "policy_sha256": policy_digest(args.policy),
         "terrain": arena.name,
         "upper_bodies": list(base.upper_bodies),
         "generator_settings": {name: repr(value) for name, value in settings.items()},

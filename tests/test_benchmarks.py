@@ -230,6 +230,28 @@ def test_guide_failures_compare_pairs_the_same_episodes(tmp_path):
         guide_failures.main(
             ["--compare", str(tmp_path / "missing.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
         )
+    # The same weights under another path (a run folder and the checkpoint copied from it) pair.
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "policy.ckpt").write_bytes(b"weights")
+    (tmp_path / "copy.ckpt").write_bytes(b"weights")
+    (tmp_path / "other.ckpt").write_bytes(b"other weights")
+    digests = {
+        name: guide_failures.policy_digest(tmp_path / name) for name in ("run", "copy.ckpt", "other.ckpt")
+    }
+    assert digests["run"] == digests["copy.ckpt"] != digests["other.ckpt"]
+    (tmp_path / "b.json").write_text(json.dumps({**before, "policy": "run", "policy_sha256": digests["run"]}))
+    (tmp_path / "a.json").write_text(
+        json.dumps({**after, "policy": "copy.ckpt", "policy_sha256": digests["copy.ckpt"]})
+    )
+    (tmp_path / "o.json").write_text(
+        json.dumps({**after, "policy": "other.ckpt", "policy_sha256": digests["other.ckpt"]})
+    )
+    paths = [str(tmp_path / "b.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
+    assert guide_failures.main(["--compare", *paths])["fixed"] == [0, 1]
+    with pytest.raises(UsageError, match="policy"):
+        guide_failures.main(
+            ["--compare", str(tmp_path / "b.json"), str(tmp_path / "o.json"), "--out", str(tmp_path)]
+        )
 
 
 def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():

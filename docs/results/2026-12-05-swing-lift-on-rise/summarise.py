@@ -72,6 +72,15 @@ def main() -> None:
     print(row("all four seeds", *every))
     print()
     print(f"Mean progress along the target direction per seed: {', '.join(f'{p:.2f}' for p in progress)} m.")
+    make_run = [failed(HERE / f"make_run/guides_seed{seed}") for seed in SEEDS]
+    starts = sum(n for _, n, _ in make_run)
+    failures = {(seed, s) for seed, (f, _, _) in zip(SEEDS, make_run) for s in f}
+    progress = sum(r["mean_progress_m"] * n for _, n, r in make_run) / starts
+    print()
+    print(
+        f"`make run`'s planner-phase policy, its own arena guides over evaluation seeds 0-3: "
+        f"{share(failures, starts)} fully covered, mean progress {progress:.2f} m."
+    )
 
 
 if __name__ == "__main__":

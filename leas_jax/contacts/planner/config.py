@@ -156,7 +156,8 @@ class GeneratorConfig:
     # its own. The plan is greedy: a foot placed well for the next pose can leave the feet
     # where a pose 1-2 s on fails, and which setting avoids it differs from guide to guide
     # (farther-ahead steps before a climb, a longer root shift over a far stance sole on
-    # rubble); see docs/results/2026-12-02-retry-settings. Only the walking settings in
+    # rubble; a swing held high over a riser); see docs/results/2026-12-02-retry-settings and
+    # 2026-12-05-swing-lift-on-rise. Only the walking settings in
     # RETRY_FIELDS may change. () never retries.
     retry_settings: tuple = (
         (("lookahead", 0.9),),

@@ -28,6 +28,27 @@ def load_average() -> dict:
     return {"1min": round(one, 2), "5min": round(five, 2), "15min": round(fifteen, 2)}
 
 
+def cpu_times(stat: str | None = None) -> tuple[int, int] | None:
+    """(busy, total) clock ticks of all CPUs together since boot, from /proc/stat's "cpu" line
+    (`stat`: that file's text; default: read it); None where there is no such file.
+    Busy is everything but idle and iowait."""
+    if stat is None:
+        try:
+            stat = Path("/proc/stat").read_text()
+        except OSError:
+            return None
+    fields = [int(v) for v in stat.splitlines()[0].split()[1:]]
+    total = sum(fields[:8])  # user nice system idle iowait irq softirq steal (guest is inside user)
+    return total - fields[3] - fields[4], total
+
+
+def busy_fraction(before, after) -> float | None:
+    """Share of the CPUs' time that was busy between two `cpu_times` readings (None without them)."""
+    if before is None or after is None or after[1] == before[1]:
+        return None
+    return round((after[0] - before[0]) / (after[1] - before[1]), 3)
+
+
 def wilson(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
     """95 % (z = 1.96) Wilson score interval of a proportion, as fractions in [0, 1] (rounding
     would put the bounds of 0 or n successes a hair past them); (nan, nan) without trials."""

@@ -26,7 +26,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import jax  # noqa: E402
-from common import add_out_argument, load_average, save  # noqa: E402
+from common import add_out_argument, busy_fraction, cpu_times, load_average, save  # noqa: E402
 from env_throughput import reference_steps_per_s  # noqa: E402
 
 
@@ -41,11 +41,11 @@ def measure(config, field, calls: int) -> dict:
     compile_s = time.perf_counter() - t0
     load_before = os.getloadavg()[0]
     reference = [reference_steps_per_s(field, config.env, config.num_envs)]
-    t0 = time.perf_counter()
+    t0, ticks = time.perf_counter(), cpu_times()
     for _ in range(calls):
         state, metrics = call(state, field)
     jax.block_until_ready(metrics)
-    run_s = time.perf_counter() - t0
+    run_s, busy = time.perf_counter() - t0, busy_fraction(ticks, cpu_times())
     reference.append(reference_steps_per_s(field, config.env, config.num_envs))
     load_after = os.getloadavg()[0]
     steps = calls * config.iterations_per_call * config.batch_size
@@ -66,6 +66,9 @@ def measure(config, field, calls: int) -> dict:
         "ratio_to_reference": round(steps / run_s / statistics.mean(reference), 4),
         # 1-minute load average before and after the timed calls: other jobs on the machine slow it down
         "load_average_1min": [round(load_before, 2), round(load_after, 2)],
+        # share of all CPUs' time busy during the timed calls (this process and any other):
+        # near 1, training is bound by the cores' compute, not by waiting
+        "cpu_busy_fraction": busy,
         "cpus": os.cpu_count(),
     }
 
@@ -133,7 +136,7 @@ def main() -> None:
                     f"{row['env_steps_per_s']:>10,} env steps/s ({row['ratio_to_reference']:.3f} of the reference env's), "
                     f"80 M steps in {row['minutes_for_80M_steps']} min "
                     f"(compile {row['compile_s']} s, load average {row['load_average_1min'][0]} -> "
-                    f"{row['load_average_1min'][1]} on {row['cpus']} CPUs)",
+                    f"{row['load_average_1min'][1]} on {row['cpus']} CPUs, busy {row['cpu_busy_fraction']})",
                     flush=True,
                 )
     save("train_throughput", {"rows": rows}, load_before, args.out)

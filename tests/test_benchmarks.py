@@ -203,6 +203,18 @@ def test_guide_failures_sets_generator_fields_from_the_command_line():
     assert "half_sitting, max_candidates=12, 1 starts" in guide_failures.markdown(report)
 
 
+def test_cpu_busy_fraction_from_proc_stat():
+    """/proc/stat's first line: user nice system idle iowait irq softirq steal guest guest_nice;
+    busy is all but idle and iowait, over the first eight fields."""
+    before = common.cpu_times("cpu  100 0 50 800 50 0 0 0 7 0\ncpu0 1 2 3 4\n")
+    after = common.cpu_times("cpu  250 0 100 850 50 0 0 0 9 0\n")
+    assert before == (150, 1000) and after == (350, 1250)
+    assert common.busy_fraction(before, after) == 0.8
+    assert common.busy_fraction(None, after) is None and common.busy_fraction(after, after) is None
+    live = common.cpu_times()
+    assert live is None or 0 <= live[0] <= live[1]
+
+
 def test_guide_failures_compare_pairs_the_same_episodes(tmp_path):
     import guide_failures
 

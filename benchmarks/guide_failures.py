@@ -126,19 +126,23 @@ def policy_digest(path) -> str:
     return hashlib.sha256(Path(policy_file(Path(path))).read_bytes()).hexdigest()
 
 
+def same_policy(before: dict, after: dict) -> bool:
+    """Whether two reports judged the same policy: the same `policy_sha256` (`policy_digest`)
+    where both hold one, else the same path."""
+    if before.get("policy_sha256") and after.get("policy_sha256"):
+        return before["policy_sha256"] == after["policy_sha256"]
+    return before.get("policy") == after.get("policy")
+
+
 def paired(before: dict, after: dict) -> dict:
     """Guide-by-guide comparison of two reports of the same episodes (policy, starts, seed,
-    spawns): full coverage before and after, the guides fixed and broken, the sign test.
-
-    The policy is the same when both reports hold the same `policy_sha256` (the file's
-    digest, `policy_digest`), else when they name the same path."""
+    spawns): full coverage before and after, the guides fixed and broken, the sign test."""
     from leas_jax.errors import UsageError
 
     keys = ("policy", "starts", "seed", "spawns", "terrain")
-    same_weights = before.get("policy_sha256") is not None and before.get("policy_sha256") == after.get(
-        "policy_sha256"
-    )
-    differ = [k for k in keys if before.get(k) != after.get(k) and not (k == "policy" and same_weights)]
+    differ = [k for k in keys[1:] if before.get(k) != after.get(k)]
+    if not same_policy(before, after):
+        differ.insert(0, "policy")
     if differ:
         raise UsageError(
             f"--compare: the reports differ in {', '.join(differ)}; only reports of the same episodes pair"

@@ -107,7 +107,7 @@ class Walking:
         target_pos = self.footholds.beam_lane(side, target_pos, target_yaw)
         lift = self._swing_lift(old_pos, target_pos)
         lifted = [(old_pos + np.array([0.0, 0.0, lift]), old_rot, False)]
-        # Or under its hip, swing_lift above its last contact (or above the half-sitting sole
+        # Or under its hip, as high above its last contact (or above the half-sitting sole
         # height where that is higher, as on a step up). The half-sitting height alone put the
         # foot 12 cm underground under a root 0.85 m above the ground, where crouched walking
         # fails otherwise (the trailing foot cannot stay flat: ankle pitch < -1.31 rad).

@@ -266,3 +266,34 @@ def test_a_refit_sets_its_threshold_for_the_configured_sensitivity(tmp_path, mon
     assert thresholds[1] <= thresholds[0]
     with pytest.raises(UsageError, match="condition_refresh_sensitivity"):
         dataclasses.replace(preset("smoke", mode="planner"), condition_refresh_sensitivity=1.5).validate()
+
+
+def test_a_run_keeps_the_learned_condition_it_started_with(tmp_path, monkeypatch):
+    """A run with the learned condition copies its weights beside its policy: relabelling the
+    default weights afterwards changes neither the resumed run nor its policy's environment."""
+    from leas_jax.feasibility import spawns
+    from leas_jax.training.policy import load_policy
+
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=TRAINING_ENV.reachability)
+    weights = lf.save_params(tmp_path / "walking.npz", {**params, "threshold": jnp.asarray(-1e9)})
+    started_with = weights.read_bytes()
+    env = dataclasses.replace(
+        TRAINING_ENV, condition="learned", learned_weights=str(weights), episode_length=20
+    )
+    config = preset(
+        "smoke", terrain="terrains/eval_ground.toml", num_timesteps=2 * 64 * 16, num_envs=64,
+        num_minibatches=2, num_epochs=1, iterations_per_call=1, checkpoint_every_s=0.0, env=env,
+    )  # fmt: skip
+    built_from = []
+    arena_field = spawns.arena_field
+    monkeypatch.setattr(
+        spawns, "arena_field", lambda terrain, env, **kw: built_from.append(env.learned_weights) or arena_field(terrain, env, **kw)
+    )  # fmt: skip
+    run = tmp_path / "run"
+    train(config, run, progress=False, stop_after_iterations=1)
+    assert (run / "condition.npz").read_bytes() == started_with
+    lf.save_params(weights, {**params, "threshold": jnp.asarray(1e9)})  # relabelled: rejects every pose
+    train(config, run, progress=False)  # resumes to the end
+    assert built_from == [str(weights), str(run / "condition.npz")]
+    assert (run / "condition.npz").read_bytes() == started_with
+    assert load_policy(run).config.env.learned_weights == str(run / "condition.npz")

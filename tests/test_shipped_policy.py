@@ -25,10 +25,18 @@ def test_shipped_policy_is_small_and_from_the_paper_preset_with_the_learned_cond
     policy = load_policy(SHIPPED)
     paper = preset("paper", mode="planner")
     # `leas train --mode planner --preset paper --reachability learned --condition-refresh-every 0`
-    assert policy.config == dataclasses.replace(paper, env=learned_condition_env(paper.env))
+    # with the learned condition it was trained with, its copy beside its policy.ckpt
+    trained = dataclasses.replace(paper, env=learned_condition_env(paper.env))
+    assert policy.config == dataclasses.replace(
+        trained, env=learned_condition_env(trained.env, str(SHIPPED / "condition.npz"))
+    )
     assert policy.env_steps >= policy.config.num_timesteps
     pretrained = load_policy(SHIPPED / "pretrain")
-    assert pretrained.config == pretraining_config(policy.config)
+    assert pretrained.config == dataclasses.replace(
+        pretraining_config(trained),
+        env=learned_condition_env(trained.env, str(SHIPPED / "pretrain" / "condition.npz")),
+    )
+    assert (SHIPPED / "condition.npz").read_bytes() == (SHIPPED / "pretrain" / "condition.npz").read_bytes()
     assert pretrained.env_steps >= pretrained.config.num_timesteps
     # one full-state checkpoint per phase: `leas train` resumes (or fine-tunes with --init) from them
     assert len(list((SHIPPED / "checkpoints").glob("step_*.ckpt"))) == 1

@@ -7,6 +7,7 @@ validate batch k while JAX rolls out batch k+1.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable
@@ -254,15 +255,18 @@ def train(
     from leas_jax.terrain import load_terrain
 
     config.validate()
+    run_dir = Path(out)
     # everything that can fail on bad input is checked before anything is written
     terrain = load_terrain(config.terrain_path())
     if field is None:
-        field = arena_field(terrain, config.env, workers=workers, progress=progress)
-    run_dir = Path(out)
+        field = arena_field(
+            terrain, _run_condition_env(run_dir, config.env), workers=workers, progress=progress
+        )
     if run_dir.exists() and not run_dir.is_dir():
         raise UsageError(f"--out {run_dir}: exists and is not a directory")
     resumed = resume_point(run_dir, allow_pickle)
     _check_config(run_dir, config, None if resumed is None else _saved_config(run_dir, resumed[1]))
+    _pin_condition(run_dir, config.env)
     init_from = config.init_from
     if config.mode == "planner" and not init_from and config.pretrain and resumed is None:
         init_from = run_dir / "pretrain"
@@ -309,6 +313,34 @@ def train(
     )
 
 
+RUN_CONDITION = "condition.npz"  # a run's own learned condition, beside its policy.ckpt (`load_policy`)
+
+
+def _run_condition_env(run_dir: Path, env):
+    """`env` with the learned condition of the run in `run_dir` where it holds one.
+
+    A run trains with the condition it started with (its copy, `_pin_condition`) or the one its
+    planner phase last refreshed, not whatever `env.learned_weights` names today: a relabelled
+    default (`benchmarks/feasibility_condition.py`) neither changes a resumed run nor the
+    environment its policy is evaluated in.
+    """
+    pinned = run_dir / RUN_CONDITION
+    if env.condition != "learned" or not pinned.is_file():
+        return env
+    return dataclasses.replace(env, learned_weights=str(pinned))
+
+
+def _pin_condition(run_dir: Path, env) -> None:
+    """Copy the learned condition's weights into `run_dir` (atomically) unless it holds them already."""
+    if env.condition != "learned" or (run_dir / RUN_CONDITION).is_file():
+        return
+    from leas_jax.env.learned_weights import resolve_weights
+    from leas_jax.files import atomic_write_bytes
+
+    run_dir.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(run_dir / RUN_CONDITION, resolve_weights(env.learned_weights).read_bytes())
+
+
 def _geometric_iterations(config, state, field, terrain, log: RunLog, stop_after, pool_options) -> TrainState:
     call = make_train_call(config)
     start_iteration = int(state.iteration)
@@ -341,8 +373,10 @@ def _planner_iterations(config, state, field, terrain, log: RunLog, stop_after, 
 
     rollout, update = make_planner_fns(config)
     verdicts = VerdictData(config, seed=config.seed)
-    if verdicts.enabled and (log.run_dir / "condition.npz").is_file():  # a resumed run's refreshed condition
-        field = field.replace(condition=load_params(log.run_dir / "condition.npz")[0])
+    if (
+        verdicts.enabled and (log.run_dir / RUN_CONDITION).is_file()
+    ):  # a given field; the run's refreshed condition
+        field = field.replace(condition=load_params(log.run_dir / RUN_CONDITION)[0])
     timestep = config.env.timestep
     state = state.replace(env_state=None, episode_return=None, episode_length=None)
     start_iteration = int(state.iteration)

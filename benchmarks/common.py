@@ -60,6 +60,16 @@ def wilson(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
+def newcombe_difference(a: tuple[int, int], b: tuple[int, int]) -> tuple[float, float, float]:
+    """p_a - p_b with its 95 % interval from the two Wilson intervals (Newcombe 1998, method 10);
+    a and b are (successes, trials) of two independent samples."""
+    pa, pb = a[0] / a[1], b[0] / b[1]
+    (la, ua), (lb, ub) = wilson(*a), wilson(*b)
+    low = pa - pb - math.sqrt((pa - la) ** 2 + (ub - pb) ** 2)
+    high = pa - pb + math.sqrt((ua - pa) ** 2 + (pb - lb) ** 2)
+    return pa - pb, low, high
+
+
 def git_state(repo: Path = REPO) -> dict:
     """Commit of `repo`'s checkout and whether its tracked files differ from it.
 

@@ -342,3 +342,10 @@ def test_train_throughput_varies_the_clearance_probes_judge_where_probes_are_eva
     paper = list(train_throughput.variants("paper", ["cylinders", "learned"], judges, []))
     assert [label for label, _ in paper] == ["cylinders", "learned"]
     assert paper[0][1][0].env.condition == "cylinders" and paper[1][1][0].env.condition == "learned"
+
+
+def test_newcombe_difference_matches_newcombes_worked_example():
+    """Newcombe (1998), Table II example (a): 56/70 - 48/80 = 0.2000, method 10: 0.0524 to 0.3339."""
+    diff, low, high = common.newcombe_difference((56, 70), (48, 80))
+    assert diff == pytest.approx(0.2) and low == pytest.approx(0.0524, abs=5e-5)
+    assert high == pytest.approx(0.3339, abs=5e-5)

@@ -11,14 +11,13 @@ fresh clone with either condition, compared the same way over its evaluation see
 """
 
 import json
-import math
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
 sys.path.insert(0, str(REPO / "benchmarks"))
-from common import wilson  # noqa: E402
+from common import newcombe_difference, wilson  # noqa: E402
 
 EARLIER = REPO / "docs/results/2026-12-02-retry-settings"
 GUIDES = {  # policy: its guide_failures.json per evaluation seed
@@ -54,15 +53,6 @@ def pooled_guides(paths: list[Path]) -> dict:
         "per_seed_progress_m": [r["mean_progress_m"] for r in runs],
         "valid_fraction": weighted("valid_fraction"),
     }
-
-
-def newcombe_difference(a: tuple[int, int], b: tuple[int, int]) -> tuple[float, float, float]:
-    """p_a - p_b with its 95 % interval from the two Wilson intervals (Newcombe's method 10)."""
-    pa, pb = a[0] / a[1], b[0] / b[1]
-    (la, ua), (lb, ub) = wilson(*a), wilson(*b)
-    low = pa - pb - math.sqrt((pa - la) ** 2 + (ub - pb) ** 2)
-    high = pa - pb + math.sqrt((ua - pa) ** 2 + (pb - lb) ** 2)
-    return pa - pb, low, high
 
 
 def leas_success(results: Path) -> dict:

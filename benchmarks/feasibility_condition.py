@@ -190,11 +190,22 @@ def main(argv=None) -> None:
     parser.add_argument("--steps", type=int, default=FitConfig.steps, help="Adam steps of the fit")
     parser.add_argument("--no-mirror", action="store_true", help="do not add the mirrored poses")
     parser.add_argument("--weights", default=DEFAULT_WEIGHTS, help="where to write the weights (.npz)")
+    parser.add_argument(
+        "--compare-weights",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="other learned-condition weights to validate on the same poses (a row each; repeatable), "
+        "e.g. the weights a policy was trained with (its run's condition.npz)",
+    )
     parser.add_argument("--cost-envs", type=int, default=2048, help="envs of the cost measurement (0: skip)")
     parser.add_argument("--cost-steps", type=int, default=100)
     parser.add_argument("--cost-repeats", type=int, default=3)
     parser.add_argument("--out", default=None, help="directory for the JSON and markdown report")
     args = parser.parse_args(argv)
+    for other in args.compare_weights:
+        if not lf.resolve_weights(other).is_file():
+            parser.error(f"--compare-weights {other}: no such file")
     for name in ("train_poses", "test_poses"):
         if getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be >= 1")
@@ -238,12 +249,15 @@ def main(argv=None) -> None:
     )
     print(f"wrote {weights} (fit {info['fit_seconds']} s, threshold {info['threshold']:.3f})")
 
+    compared = {name: lf.load_params(lf.resolve_weights(name))[0] for name in args.compare_weights}
     validation = {}
     for set_name in ("fresh", "policy"):
         poses, truth = sets[set_name]
         if not len(poses):
             continue
         rows = {"learned": rv.rates(predict(params, xs[set_name]), truth)}
+        for name, other in compared.items():
+            rows[f"learned ({name})"] = rv.rates(predict(other, features_of(other, plain, poses)), truth)
         for name, cyl in (
             ("cylinders (ReachabilityConfig)", ReachabilityConfig()),
             ("cylinders (training)", TRAINING_REACHABILITY),

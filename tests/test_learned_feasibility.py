@@ -273,25 +273,20 @@ def test_feasibility_condition_benchmark_runs_end_to_end(tmp_path, monkeypatch):
     monkeypatch.setattr(fd, "cache_file", lambda name, key: tmp_path / f"labels_{name}_{key[:16]}.npz")
     weights = tmp_path / "w.npz"
     report = tmp_path / "report"
-    bench.main(
-        ["--train-poses", "24", "--test-poses", "12", "--policy-train-poses", "0", "--policy-poses", "0"]
-        + [
-            "--workers",
-            "0",
-            "--steps",
-            "20",
-            "--cost-envs",
-            "0",
-            "--weights",
-            str(weights),
-            "--out",
-            str(report),
-        ]
-    )
+    params = lf.init_params(jax.random.PRNGKey(0), reach=EnvConfig().reachability)
+    reject = lf.save_params(tmp_path / "reject.npz", {**params, "threshold": jnp.asarray(1e9)})
+    tiny = ["--train-poses", "24", "--test-poses", "12", "--policy-train-poses", "0", "--policy-poses", "0"]
+    tiny += ["--workers", "0", "--steps", "20", "--cost-envs", "0", "--weights", str(weights)]
+    bench.main([*tiny, "--compare-weights", str(reject), "--out", str(report)])
     saved = json.loads((report / "feasibility_condition.json").read_text())
     assert {"machine", "git", "load_average_before"} <= set(saved)
     learned = saved["validation"]["fresh"]["learned"]
     assert learned["tp"] + learned["fn"] + learned["fp"] + learned["tn"] == 12
+    # other weights validated on the same poses: these call every pose infeasible
+    rejecting = saved["validation"]["fresh"][f"learned ({reject})"]
+    assert rejecting["tp"] == rejecting["fp"] == 0 and rejecting["fn"] == learned["tp"] + learned["fn"]
+    with pytest.raises(SystemExit):
+        bench.main([*tiny, "--compare-weights", str(tmp_path / "missing.npz")])
     params, metadata = lf.load_params(weights)
     assert metadata["data_key"] == saved["data_key"]
     assert "| fresh |" in (report / "feasibility_condition.md").read_text()

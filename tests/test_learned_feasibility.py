@@ -168,7 +168,7 @@ def test_env_selects_the_learned_condition(tmp_path):
 def test_shipped_weights_agree_with_the_generator_on_held_out_poses():
     """Parity: the committed weights (benchmarks/feasibility_condition.py) against the contact
     generator's walking truth on 24 arena poses none of their data holds (seed 99). On 4 000
-    fresh poses they reach 94.1 % sensitivity and 91.8 % specificity (~92 % agreement);
+    fresh poses they reach 92.1 % sensitivity and 95.1 % specificity (~94 % agreement);
     below 70 % on 24 poses would have probability < 1e-3 at that rate."""
     import sys
 

@@ -11,7 +11,7 @@ PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 \
   --compare-weights checkpoints/leas_talos/condition.npz --out $D/feasibility
 
 # 2. `make run` from a fresh clone of the commit holding the new weights (~22 min), then its
-#    planner-phase policy's own arena guides, evaluation seeds 0-3 (~7 min):
+#    planner-phase policy's own arena guides, evaluation seeds 0-3 (~5 min):
 #   git clone . /tmp/mr && (cd /tmp/mr && time make run)
 #   for S in 0 1 2 3; do PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy /tmp/mr/runs/quick/planner \
 #     --starts 256 --workers 2 --spawns condition --seed $S --out $D/make_run/guides_seed$S; done

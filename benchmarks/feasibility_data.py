@@ -11,7 +11,7 @@ that starts at the pose along its yaw. Two pose sets:
   condition matters.
 
 Labels are cached in .cache/feasibility_<set>_<key>.npz at the repository root, where
-<key> hashes everything a label depends on (`dataset_key`): the terrain file's text,
+<key> hashes everything a label depends on (`walking_truth.dataset_key`): the terrain file's text,
 the generator's settings (`GeneratorConfig`), the generator's sources
 (leas_jax/contacts/**/*.py and leas_jax/terrain/**/*.py) and the walking truth's guide. A change to any of them gives
 another key, so the labels are rebuilt. Labels are computed in chunks and the cache is
@@ -22,7 +22,6 @@ Host-only.
 
 from __future__ import annotations
 
-import hashlib
 import multiprocessing
 import sys
 import time
@@ -35,31 +34,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reachability_calibration as rc  # noqa: E402
 
 from leas_jax.feasibility.label_cache import cached_labels  # noqa: E402
+from leas_jax.feasibility.walking_truth import dataset_key  # noqa: E402,F401 (the labels' key, used by the benchmarks)
 
 REPO = rc.REPO
 CACHE = REPO / ".cache"
 CHUNK = 50  # poses per labelling task: a cache write every CHUNK * workers poses
-
-
-def dataset_key(terrain_text: str, generator_config, sources_root: Path | None = None) -> str:
-    """sha256 (hex) of what a walking-truth label depends on.
-
-    Args:
-        terrain_text: the terrain file's text.
-        generator_config: the `GeneratorConfig` the labels are made with (its repr holds every field).
-        sources_root: a folder whose .py files stand for the generator's code (None: the
-            package's, `spawns.GENERATOR_SOURCES`: the generator and the terrain code).
-    """
-    from leas_jax.feasibility.spawns import GENERATOR_SOURCES, generator_code_digest
-
-    digest = hashlib.sha256()
-    digest.update(f"walking {rc.WALK_POSES} {rc.WALK_SPEED} {rc.WALK_TIMESTEP}\n".encode())
-    digest.update(repr(generator_config).encode())
-    digest.update(terrain_text.encode())
-    digest.update(
-        generator_code_digest(GENERATOR_SOURCES if sources_root is None else (sources_root,)).encode()
-    )
-    return digest.hexdigest()
 
 
 def cache_file(name: str, key: str, cache: Path = CACHE) -> Path:

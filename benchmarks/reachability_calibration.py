@@ -75,6 +75,13 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from leas_jax.feasibility.walking_truth import (  # noqa: E402,F401 (the walking truth, used by the benchmarks)
+    WALK_POSES,
+    WALK_SPEED,
+    WALK_TIMESTEP,
+    walking_guide,
+)
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 REPO = Path(__file__).resolve().parent.parent
@@ -185,20 +192,6 @@ def _init_worker(terrain_text: str) -> None:
     from leas_jax.terrain import loads_terrain
 
     _WORKER["generator"] = ContactGenerator(loads_terrain(terrain_text, source="<calibration>"))
-
-
-WALK_POSES = 21  # walking truth: guide poses 0.018 m apart (0.36 m in 2 s: two or three footsteps)
-WALK_SPEED = 0.18  # m/s, the target speed (paper §IV)
-WALK_TIMESTEP = 0.1  # s, paper Table I
-
-
-def walking_guide(pose: np.ndarray) -> np.ndarray:
-    """[WALK_POSES, 4] guide from `pose` straight ahead along its yaw at WALK_SPEED, same z and yaw."""
-    steps = np.arange(WALK_POSES) * WALK_SPEED * WALK_TIMESTEP
-    guide = np.repeat(np.asarray(pose, np.float64)[None], WALK_POSES, axis=0)
-    guide[:, 0] += steps * np.cos(pose[3])
-    guide[:, 1] += steps * np.sin(pose[3])
-    return guide
 
 
 def _feasible_one(generator, pose, truth: str) -> bool:

@@ -3,6 +3,7 @@ become labelled poses, the policy's failed poses among them, and refresh the con
 
 import dataclasses
 import os
+import warnings
 from types import SimpleNamespace
 
 import jax
@@ -297,3 +298,22 @@ def test_a_run_keeps_the_learned_condition_it_started_with(tmp_path, monkeypatch
     assert built_from == [str(weights), str(run / "condition.npz")]
     assert (run / "condition.npz").read_bytes() == started_with
     assert load_policy(run).config.env.learned_weights == str(run / "condition.npz")
+
+
+def test_a_run_starting_with_weights_of_another_generator_warns(tmp_path):
+    """A new run copying weights whose labels' key is not the current generator's warns once,
+    naming the file; a run that holds its copy already (resuming) does not check again."""
+    from leas_jax.feasibility.walking_truth import StaleConditionWarning
+    from leas_jax.training.loop import RUN_CONDITION, _pin_condition
+
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=TRAINING_ENV.reachability)
+    weights = lf.save_params(
+        tmp_path / "walking.npz", params, data_key="0" * 64, terrain="terrains/training_arena.toml"
+    )
+    env = dataclasses.replace(TRAINING_ENV, condition="learned", learned_weights=str(weights))
+    with pytest.warns(StaleConditionWarning, match="walking.npz: the learned condition was fitted"):
+        _pin_condition(tmp_path / "run", env)
+    assert (tmp_path / "run" / RUN_CONDITION).read_bytes() == weights.read_bytes()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _pin_condition(tmp_path / "run", env)

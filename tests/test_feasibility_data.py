@@ -74,3 +74,18 @@ def test_cache_reused_rebuilt_when_the_key_changes_and_resumed(tmp_path):
 
 def test_cache_file_names_hold_the_key():
     assert fd.cache_file("fresh10_seed1", "ab" * 32).name == f"feasibility_fresh10_seed1_{'ab' * 8}.npz"
+
+
+def test_weights_fitted_on_another_generator_are_named_stale():
+    """`walking_truth.stale_weights`: weights whose labels' key is the current generator's pass;
+    another generator's key gives one message naming the file and the relabelling command;
+    weights that carry no key (the planner phase's refits) cannot be judged."""
+    from leas_jax.feasibility.walking_truth import RELABEL_COMMAND, dataset_key, stale_weights
+
+    arena = "terrains/training_arena.toml"
+    current = dataset_key((Path(__file__).resolve().parents[1] / arena).read_text(), GeneratorConfig())
+    assert stale_weights(Path("w.npz"), {"data_key": current, "terrain": arena}) is None
+    other = dataclasses.replace(GeneratorConfig(), step_trigger=0.08)
+    message = stale_weights(Path("w.npz"), {"data_key": current, "terrain": arena}, other)
+    assert message.startswith("w.npz: ") and RELABEL_COMMAND in message and current[:12] in message
+    assert stale_weights(Path("w.npz"), {"refreshes": "3"}) is None

@@ -331,14 +331,22 @@ def _run_condition_env(run_dir: Path, env):
 
 
 def _pin_condition(run_dir: Path, env) -> None:
-    """Copy the learned condition's weights into `run_dir` (atomically) unless it holds them already."""
+    """Copy the learned condition's weights into `run_dir` (atomically) unless it holds them already.
+
+    Warns (`walking_truth.StaleConditionWarning`) where the weights were fitted on the verdicts
+    of another contact generator than the current one: the run would learn to satisfy a
+    condition the generator no longer agrees with.
+    """
     if env.condition != "learned" or (run_dir / RUN_CONDITION).is_file():
         return
-    from leas_jax.env.learned_weights import resolve_weights
+    from leas_jax.env.learned_weights import load_params, resolve_weights
+    from leas_jax.feasibility.walking_truth import warn_if_stale
     from leas_jax.files import atomic_write_bytes
 
+    weights = resolve_weights(env.learned_weights)
+    warn_if_stale(weights, load_params(weights)[1])
     run_dir.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(run_dir / RUN_CONDITION, resolve_weights(env.learned_weights).read_bytes())
+    atomic_write_bytes(run_dir / RUN_CONDITION, weights.read_bytes())
 
 
 def _geometric_iterations(config, state, field, terrain, log: RunLog, stop_after, pool_options) -> TrainState:

@@ -49,6 +49,29 @@ def test_grid_and_feature_shapes():
     assert lf.valid(params, FIELD, jnp.zeros(4), reach).dtype == jnp.bool_
 
 
+def test_the_local_ground_is_the_highest_terrain_near_the_root(tmp_path):
+    """The height-above-ground feature reads the grid points within GROUND_RADIUS of the root
+    (`ground_index`, derived from the grid, not stored in the weights file); with none it is
+    the clip's top."""
+    reach = TRAINING_ENV.reachability
+    params = lf.init_params(jax.random.PRNGKey(0), reach=reach)
+    grid, ground = np.asarray(params["grid"]), np.asarray(params["ground_index"])
+    assert len(ground) == 13 and np.all(np.sum(grid[ground] ** 2, axis=-1) <= lf.GROUND_RADIUS**2)
+    above = len(grid)  # the feature's index
+    # the wall (x 4.3-4.7, 1.5 m high) 0.5 m ahead: in the patch, not the ground
+    assert lf.features(params, FIELD, jnp.array([3.8, 3.0, 1.0, 0.0]), reach)[above] == pytest.approx(1.0)
+    # the root 0.05 m past the wall's edge, 2.2 m up: the wall's top is the ground
+    assert lf.features(params, FIELD, jnp.array([4.35, 3.0, 2.2, 0.0]), reach)[above] == pytest.approx(0.7)
+    path = lf.save_params(tmp_path / "w.npz", params)
+    with np.load(path) as stored:
+        assert "ground_index" not in stored.files
+    np.testing.assert_array_equal(np.asarray(lf.load_params(path)[0]["ground_index"]), ground)
+    ahead_only = lf.init_params(jax.random.PRNGKey(0), grid=lf.patch_grid(x_range=(0.4, 0.64)), reach=reach)
+    assert ahead_only["ground_index"].shape == (0,)
+    x = lf.features(ahead_only, FIELD, jnp.array([2.0, 3.0, 1.0, 0.0]), reach)
+    assert x[len(ahead_only["grid"])] == pytest.approx(lf.HEIGHT_CLIP[1])
+
+
 def test_patch_turns_with_the_yaw():
     """The wall 0.5 m ahead of the root (x 4.3) shows at root-frame x 0.48-0.56 when facing +x,
     and behind-free when the root faces -x."""

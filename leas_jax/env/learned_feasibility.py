@@ -35,17 +35,16 @@ from leas_jax.env.config import ReachabilityConfig
 from leas_jax.env.field import Heightfield, sample_nearest_xy
 from leas_jax.env.kinematics import world_xy
 from leas_jax.env.learned_weights import (  # noqa: F401 (the weights' file API, re-exported)
+    GROUND_RADIUS,
     LAYER_KEYS,
     LearnedParams,
     load_params,
     margin_count,
     resolve_weights,
     save_params,
+    with_ground_index,
 )
 
-# m, the local ground is the highest terrain point within this radius of the root (the pose
-# sampler's reference ground uses 0.15 m; grid points within it at a 0.08 m spacing: 9)
-GROUND_RADIUS = 0.17
 # m, the grid: behind the heels to past the next footsteps (the walking truth's guide is
 # 0.36 m), across past the half-sitting grippers (0.55 m beside the root)
 PATCH_X = (-0.40, 0.64)
@@ -93,6 +92,7 @@ def raw_features(
     field: Heightfield,
     pose: jax.Array,
     grid: jax.Array,
+    ground: jax.Array,
     clip: jax.Array,
     reach: ReachabilityConfig = ReachabilityConfig(),
 ) -> jax.Array:
@@ -102,6 +102,7 @@ def raw_features(
         field: the terrain, with the rasters of `reach`.
         pose: [4] (x, y, z, yaw), world.
         grid: [P, 2] root-frame patch points (m).
+        ground: [G] int, the grid points within GROUND_RADIUS of the root (`ground_index`).
         clip: [2] (lo, hi) of the relative heights (m).
         reach: the cylinders whose margins are read.
 
@@ -111,8 +112,14 @@ def raw_features(
     """
     x, y = world_xy(pose, grid)
     relative = sample_nearest_xy(field, field.heights, x, y) - pose[2]
-    near = jnp.sum(grid**2, axis=-1) <= GROUND_RADIUS**2
-    above_ground = -jnp.max(jnp.where(near, relative, -jnp.inf))
+    # The ground's points are sampled again rather than read from `relative`: the same values,
+    # but XLA's CPU backend does not fuse a gather read both by the patch and by a reduction,
+    # which made `quick` training with this condition about 1.1 x slower on 2 cores
+    # (`benchmarks/train_throughput.py`, docs/results/2026-12-05-condition-ground-gather).
+    ground_x, ground_y = world_xy(pose, grid[ground])
+    above_ground = pose[2] - jnp.max(
+        sample_nearest_xy(field, field.heights, ground_x, ground_y), initial=-jnp.inf
+    )
     return jnp.concatenate(
         [
             jnp.clip(relative, clip[0], clip[1]),
@@ -129,7 +136,7 @@ def features(
     reach: ReachabilityConfig = ReachabilityConfig(),
 ) -> jax.Array:
     """[P + 1 + M] raw features of one pose [4] on the params' grid and clip."""
-    return raw_features(field, pose, params["grid"], params["clip"], reach)
+    return raw_features(field, pose, params["grid"], params["ground_index"], params["clip"], reach)
 
 
 def logit_of_features(params: LearnedParams, x: jax.Array) -> jax.Array:
@@ -170,9 +177,9 @@ def init_params(
 ) -> LearnedParams:
     """Random parameters (Glorot-uniform weights, zero biases, identity standardisation, threshold 0).
 
-    Keys and shapes: grid [P, 2], clip [2], mean and std [F] (F = P + 1 + M, M =
-    `margin_count(reach)`), w0 [F, H0], b0 [H0], w1 [H0, H1], b1 [H1], w2 [H1, 1], b2 [1],
-    threshold [].
+    Keys and shapes: grid [P, 2], ground_index [G] (derived from the grid), clip [2], mean and
+    std [F] (F = P + 1 + M, M = `margin_count(reach)`), w0 [F, H0], b0 [H0], w1 [H0, H1], b1
+    [H1], w2 [H1, 1], b2 [1], threshold [].
     """
     grid = patch_grid() if grid is None else np.asarray(grid, np.float32)
     sizes = (len(grid) + 1 + margin_count(reach), *hidden, 1)
@@ -189,4 +196,4 @@ def init_params(
         limit = np.sqrt(6.0 / (n_in + n_out))
         params[f"w{layer}"] = jax.random.uniform(k, (n_in, n_out), minval=-limit, maxval=limit)
         params[f"b{layer}"] = jnp.zeros(n_out)
-    return params
+    return with_ground_index(params)

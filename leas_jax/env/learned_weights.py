@@ -18,6 +18,9 @@ import numpy as np
 from leas_jax.env.config import EnvConfig, ReachabilityConfig
 
 LAYER_KEYS = ("w0", "b0", "w1", "b1", "w2", "b2")
+# m, the local ground is the highest terrain point within this radius of the root (the pose
+# sampler's reference ground uses 0.15 m; grid points within it at a 0.08 m spacing: 13)
+GROUND_RADIUS = 0.17
 REPO_ROOT = Path(__file__).resolve().parents[2]
 
 LearnedParams = dict  # str -> jax.Array (see `learned_feasibility.init_params` for the keys and shapes)
@@ -41,12 +44,26 @@ def resolve_weights(path: str | Path) -> Path:
     return path if path.exists() or path.is_absolute() else REPO_ROOT / path
 
 
+def ground_index(grid) -> np.ndarray:
+    """[G] int32, the points of a patch grid [P, 2] (root frame, m) within GROUND_RADIUS of the root."""
+    grid = np.asarray(grid)
+    return np.flatnonzero(np.sum(grid**2, axis=-1) <= GROUND_RADIUS**2).astype(np.int32)
+
+
+def with_ground_index(params: LearnedParams) -> LearnedParams:
+    """params with "ground_index" = `ground_index(params["grid"])`, derived on the host: in jitted
+    code the grid is traced, and the index's static shape lets the condition sample the ground's
+    few points on their own (`learned_feasibility.raw_features`)."""
+    return {**params, "ground_index": jnp.asarray(ground_index(params["grid"]))}
+
+
 def save_params(path: str | Path, params: LearnedParams, **metadata) -> Path:
-    """Write params (and string metadata, e.g. the data key) to an .npz file, atomically."""
+    """Write params (and string metadata, e.g. the data key) to an .npz file, atomically. The
+    derived "ground_index" is not written (`load_params` derives it again)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + f".tmp{os.getpid()}.npz")
-    arrays = {k: np.asarray(v) for k, v in params.items()}
+    arrays = {k: np.asarray(v) for k, v in params.items() if k != "ground_index"}
     np.savez(tmp, **arrays, **{f"meta_{k}": np.asarray(str(v)) for k, v in metadata.items()})
     os.replace(tmp, path)
     return path
@@ -69,7 +86,7 @@ def load_params(path: str | Path) -> tuple[LearnedParams, dict]:
         raise ValueError(f"{path}: not a learned condition's weights (missing {', '.join(missing)})")
     params = {k: jnp.asarray(arrays[k], jnp.float32) for k in needed}
     metadata = {k[len("meta_") :]: str(v) for k, v in arrays.items() if k.startswith("meta_")}
-    return params, metadata
+    return with_ground_index(params), metadata
 
 
 def condition_params(config: EnvConfig) -> dict:

@@ -50,14 +50,12 @@ def features_of(
 ) -> np.ndarray:
     """Raw features [N, F] of poses [N, 4] on the params' grid (jitted, vmapped); the field must
     carry the rasters of `reach`."""
-    return np.asarray(
-        _features(params["grid"], params["clip"], field, jnp.asarray(poses, jnp.float32), reach)
-    )
+    return np.asarray(_features(params, field, jnp.asarray(poses, jnp.float32), reach))
 
 
 @functools.partial(jax.jit, static_argnames=("reach",))
-def _features(grid, clip, field, poses, reach):
-    return jax.vmap(lambda p: lf.raw_features(field, p, grid, clip, reach))(poses)
+def _features(params, field, poses, reach):
+    return jax.vmap(lambda p: lf.features(params, field, p, reach))(poses)
 
 
 def mirrored(x: np.ndarray, grid: np.ndarray, reach: ReachabilityConfig = ReachabilityConfig()) -> np.ndarray:

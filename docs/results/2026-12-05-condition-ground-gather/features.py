@@ -27,10 +27,13 @@ def dump(out: str) -> None:
     poses = np.column_stack(
         [rng.uniform(-2, 30, n), rng.uniform(-2, 30, n), rng.uniform(-1.5, 2.5, n), rng.uniform(-4, 4, n)]
     )
-    one = lambda f, q: (
-        lf.features(f.condition, f, q, env.reachability),
-        lf.valid(f.condition, f, q, env.reachability),
-    )  # noqa: E731
+
+    def one(f, q):
+        return (
+            lf.features(f.condition, f, q, env.reachability),
+            lf.valid(f.condition, f, q, env.reachability),
+        )
+
     features, valid = jax.jit(lambda f, p: jax.vmap(lambda q: one(f, q))(p))(
         field, jnp.asarray(poses, jnp.float32)
     )

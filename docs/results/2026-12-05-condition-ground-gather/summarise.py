@@ -13,7 +13,7 @@ RUNS = ("before1", "after1", "before2", "after2")
 
 def minutes(run: str) -> dict:
     """(preset, condition) -> minutes per 80 M env steps of one run."""
-    rows = json.loads((HERE / run / "train_throughput.json").read_text())["leas_jax"]
+    rows = json.loads((HERE / run / "train_throughput.json").read_text())["rows"]
     return {(r["preset"], r["condition"]): r["minutes_for_80M_steps"] for r in rows}
 
 

@@ -46,6 +46,8 @@ import feasibility_data as fd  # noqa: E402
 import reachability_calibration as rc  # noqa: E402
 import reachability_validation as rv  # noqa: E402
 
+from leas_jax.feasibility.walking_truth import dataset_key  # noqa: E402
+
 DEFAULT_WEIGHTS = "checkpoints/feasibility/walking.npz"
 
 
@@ -235,7 +237,7 @@ def main(argv=None) -> None:
     info["fit_seconds"] = round(time.perf_counter() - t0, 1)
     from leas_jax.contacts.planner.generator import GeneratorConfig
 
-    key = fd.dataset_key(terrain.text, GeneratorConfig())
+    key = dataset_key(terrain.text, GeneratorConfig())
     weights = lf.resolve_weights(args.weights)
     lf.save_params(
         weights,

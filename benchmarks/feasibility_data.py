@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reachability_calibration as rc  # noqa: E402
 
 from leas_jax.feasibility.label_cache import cached_labels  # noqa: E402
-from leas_jax.feasibility.walking_truth import dataset_key  # noqa: E402,F401 (the labels' key, used by the benchmarks)
+from leas_jax.feasibility.walking_truth import WALK_TIMESTEP, dataset_key, walking_guide  # noqa: E402
 
 REPO = rc.REPO
 CACHE = REPO / ".cache"
@@ -72,7 +72,7 @@ def _init_worker(terrain_text: str, generator_config) -> None:
 def _walking_labels(poses: np.ndarray) -> np.ndarray:
     generator = _WORKER["generator"]
     return np.array(
-        [generator.plan(rc.walking_guide(p), rc.WALK_TIMESTEP).coverage >= 1.0 for p in poses], dtype=bool
+        [generator.plan(walking_guide(p), WALK_TIMESTEP).coverage >= 1.0 for p in poses], dtype=bool
     )
 
 

@@ -75,7 +75,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from leas_jax.feasibility.walking_truth import (  # noqa: E402,F401 (the walking truth, used by the benchmarks)
+from leas_jax.feasibility.walking_truth import (  # noqa: E402
     WALK_POSES,
     WALK_SPEED,
     WALK_TIMESTEP,

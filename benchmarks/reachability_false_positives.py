@@ -46,6 +46,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import reachability_calibration as rc  # noqa: E402
 
+from leas_jax.feasibility.walking_truth import WALK_SPEED, WALK_TIMESTEP, walking_guide  # noqa: E402
+
 SOLE_RADIUS = 0.08  # m, disk of the leg spread (sole 0.20 x 0.13 m: inscribed 0.065, circumscribed 0.12)
 EDGE_JUMP = 0.03  # m, a height jump between neighbouring cells that makes an edge
 NEAR_EDGE = 0.20  # m, "near an edge"
@@ -120,8 +122,8 @@ def features(terrain, poses: np.ndarray, config) -> dict:
 
 
 def valid_ahead(terrain, poses: np.ndarray, config) -> np.ndarray:
-    """[N] whether the condition holds at every pose of each pose's walking guide (rc.walking_guide)."""
-    guides = np.stack([rc.walking_guide(p) for p in poses])  # [N, WALK_POSES, 4]
+    """[N] whether the condition holds at every pose of each pose's walking guide (`walking_truth.walking_guide`)."""
+    guides = np.stack([walking_guide(p) for p in poses])  # [N, WALK_POSES, 4]
     return rc.condition(terrain, guides.reshape(-1, 4), config).reshape(len(poses), -1).all(axis=1)
 
 
@@ -130,7 +132,7 @@ def _outcome_chunk(poses: np.ndarray) -> np.ndarray:
     generator = rc._WORKER["generator"]
     out = np.zeros((len(poses), 2), dtype=np.int64)
     for n, pose in enumerate(poses):
-        plan = generator.plan(rc.walking_guide(pose), rc.WALK_TIMESTEP)
+        plan = generator.plan(walking_guide(pose), WALK_TIMESTEP)
         out[n, 0] = plan.last_valid_index
         if plan.last_valid_index < 0:  # which part of the initial stance failed
             feet = [None, None]
@@ -231,7 +233,7 @@ def main(argv=None) -> None:
             outcomes[:, 0] >= 0,
             np.char.add(
                 "stops after ",
-                (np.maximum(outcomes[:, 0], 0) * rc.WALK_SPEED * rc.WALK_TIMESTEP).round(2).astype(str),
+                (np.maximum(outcomes[:, 0], 0) * WALK_SPEED * WALK_TIMESTEP).round(2).astype(str),
             ),
             np.where(outcomes[:, 1] == 1, "cannot stand: posture", "cannot stand: no foothold"),
         )

@@ -18,6 +18,7 @@ import pytest
 from leas_jax.contacts.planner.generator import ContactPosture, double_support_posture
 from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT
 from leas_jax.env import ReachabilityConfig
+from leas_jax.feasibility.walking_truth import WALK_POSES, walking_guide
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import REACHABILITY_TERMS_OFF
 
@@ -180,8 +181,8 @@ def test_walking_truth_rejects_crouched_roots_the_static_truth_accepts():
     walking = rc.ground_truth(TERRAIN, poses, workers=1, truth="walking")
     np.testing.assert_array_equal(static, [True] * 6)
     np.testing.assert_array_equal(walking, [True] * 3 + [False] * 3)
-    guide = rc.walking_guide(POSES[0])
-    assert guide.shape == (rc.WALK_POSES, 4)
+    guide = walking_guide(POSES[0])
+    assert guide.shape == (WALK_POSES, 4)
     np.testing.assert_allclose(np.hypot(*(guide[-1, :2] - guide[0, :2])), 0.36, atol=1e-9)
 
 

@@ -9,6 +9,7 @@ import pytest
 
 from leas_jax.contacts.planner.generator import GeneratorConfig
 from leas_jax.feasibility.label_cache import cached_labels, load_partial
+from leas_jax.feasibility.walking_truth import dataset_key
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 import feasibility_data as fd  # noqa: E402
@@ -17,16 +18,16 @@ TERRAIN = (Path(__file__).parent / "data" / "slab_with_wall.toml").read_text()
 
 
 def test_key_changes_with_the_generator_config_the_terrain_and_the_sources(tmp_path):
-    base = fd.dataset_key(TERRAIN, GeneratorConfig())
-    assert fd.dataset_key(TERRAIN, GeneratorConfig()) == base
-    assert fd.dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), step_trigger=0.08)) != base
-    assert fd.dataset_key(TERRAIN + "\n# edited\n", GeneratorConfig()) != base
+    base = dataset_key(TERRAIN, GeneratorConfig())
+    assert dataset_key(TERRAIN, GeneratorConfig()) == base
+    assert dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), step_trigger=0.08)) != base
+    assert dataset_key(TERRAIN + "\n# edited\n", GeneratorConfig()) != base
     sources = tmp_path / "contacts" / "planner"
     sources.mkdir(parents=True)
     (sources / "generator.py").write_text("x = 1\n")
-    first = fd.dataset_key(TERRAIN, GeneratorConfig(), tmp_path / "contacts")
+    first = dataset_key(TERRAIN, GeneratorConfig(), tmp_path / "contacts")
     (sources / "generator.py").write_text("x = 2\n")  # a sub-package's source counts too
-    assert fd.dataset_key(TERRAIN, GeneratorConfig(), tmp_path / "contacts") != first
+    assert dataset_key(TERRAIN, GeneratorConfig(), tmp_path / "contacts") != first
 
 
 class Labeller:
@@ -47,7 +48,7 @@ class Labeller:
 def test_cache_reused_rebuilt_when_the_key_changes_and_resumed(tmp_path):
     poses = np.random.default_rng(0).normal(size=(25, 4))
     path = tmp_path / "labels.npz"
-    key = fd.dataset_key(TERRAIN, GeneratorConfig())
+    key = dataset_key(TERRAIN, GeneratorConfig())
     first = Labeller()
     labels = cached_labels(poses, key, path, first, chunk=10)
     np.testing.assert_array_equal(labels, poses[:, 0] > 0)
@@ -55,7 +56,7 @@ def test_cache_reused_rebuilt_when_the_key_changes_and_resumed(tmp_path):
     again = Labeller()
     np.testing.assert_array_equal(cached_labels(poses, key, path, again, chunk=10), labels)
     assert again.poses == 0  # from the cache
-    other_key = fd.dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), max_candidates=8))
+    other_key = dataset_key(TERRAIN, dataclasses.replace(GeneratorConfig(), max_candidates=8))
     rebuilt = Labeller()
     cached_labels(poses, other_key, path, rebuilt, chunk=10)
     assert rebuilt.poses == 25  # the generator config changed: every label recomputed
@@ -80,7 +81,7 @@ def test_weights_fitted_on_another_generator_are_named_stale():
     """`walking_truth.stale_weights`: weights whose labels' key is the current generator's pass;
     another generator's key gives one message naming the file and the relabelling command;
     weights that carry no key (the planner phase's refits) cannot be judged."""
-    from leas_jax.feasibility.walking_truth import RELABEL_COMMAND, dataset_key, stale_weights
+    from leas_jax.feasibility.walking_truth import RELABEL_COMMAND, stale_weights
 
     arena = "terrains/training_arena.toml"
     current = dataset_key((Path(__file__).resolve().parents[1] / arena).read_text(), GeneratorConfig())

@@ -14,6 +14,7 @@ from leas_jax.env import EnvConfig, LeasEnv, condition, heightfield_from_terrain
 from leas_jax.env import learned_feasibility as lf
 from leas_jax.feasibility import FitConfig, features_of, fit, predict
 from leas_jax.feasibility.fit import balanced_weights, mirrored, threshold_for
+from leas_jax.feasibility.walking_truth import WALK_TIMESTEP, walking_guide
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import TRAINING_ENV
 
@@ -208,7 +209,7 @@ def test_shipped_weights_agree_with_the_generator_on_held_out_poses():
         jax.jit(jax.vmap(lambda p: condition.valid(field, p, config)))(jnp.asarray(poses, jnp.float32))
     )
     generator = ContactGenerator(arena)
-    truth = np.array([generator.plan(rc.walking_guide(p), rc.WALK_TIMESTEP).coverage >= 1.0 for p in poses])
+    truth = np.array([generator.plan(walking_guide(p), WALK_TIMESTEP).coverage >= 1.0 for p in poses])
     assert truth.any() and not truth.all()
     assert (ours == truth).mean() >= 0.70, (ours, truth)
 

@@ -6,10 +6,12 @@ import sys
 import numpy as np
 import pytest
 
-from leas_jax.cli import main
+from leas_jax.cli import attach_negative_values, build_parser, main
 from leas_jax.errors import UsageError
 
 ARENA = "terrains/training_arena.toml"
+ROLLOUT = ["rollout", "--checkpoint", "c", "--terrain", ARENA, "--out", "g.npz"]
+NAVIGATE = ["navigate", "--checkpoint", "c", "--terrain", ARENA, "--out", "p.npz"]
 
 
 @pytest.mark.parametrize(
@@ -35,6 +37,13 @@ ARENA = "terrains/training_arena.toml"
         ),
         (["rollout"], "the following arguments are required"),
         (["bogus"], "invalid choice: 'bogus'"),
+        ([*ROLLOUT, "--start", "-0.9,abc,0", "--target", "3,4"], "--start expects 3"),
+        ([*ROLLOUT, "--start", "1,2,0", "--target", "-1"], "--target expects 2"),
+        ([*ROLLOUT, "--start", "1,2,0", "--target", "-1,-2,-3"], "--target expects 2"),
+        ([*NAVIGATE, "--start", "-1,-2,nan", "--goal", "3,4"], "--start expects 3"),
+        ([*NAVIGATE, "--start", "1,2,0", "--goal", "-.5,x"], "--goal expects 2"),
+        ([*NAVIGATE, "--start", "1,2,0", "--goal", "3,4", "--via", "-1,2,3"], "--via expects 2"),
+        ([*NAVIGATE, "--start", "1,2,0", "--goal", "3,4", "--degrees", "-1,2"], "ignored explicit argument"),
     ],
 )
 def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
@@ -43,6 +52,46 @@ def test_argument_errors_are_one_line_with_exit_code_2(capsys, argv, fragment):
     err = capsys.readouterr().err.strip()
     assert exit_info.value.code == 2
     assert len(err.splitlines()) == 1 and fragment in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "argv, expected",
+    [
+        (
+            [*ROLLOUT, "--start", "-0.9,1.7,0", "--target", "-1,-2"],
+            {"start": [-0.9, 1.7, 0.0], "target": [-1.0, -2.0]},
+        ),
+        (
+            [*ROLLOUT, "--start", "-.5,3,0", "--target", "-2.5e-1,4", "--speed", "-0.1"],
+            {"start": [-0.5, 3.0, 0.0], "target": [-0.25, 4.0], "speed": -0.1},
+        ),
+        (
+            [*NAVIGATE, "--start", "-0.9,1.7,0", "--goal", "-1,-2", "--via", "-.5,3", "--via", "1,-2"],
+            {"start": [-0.9, 1.7, 0.0], "goal": [-1.0, -2.0], "via": [[-0.5, 3.0], [1.0, -2.0]]},
+        ),
+        (
+            [*NAVIGATE, "--goal=-1,-2", "--start", "-3,-4,-90", "--degrees"],
+            {"start": [-3.0, -4.0, -90.0], "goal": [-1.0, -2.0], "degrees": True},
+        ),
+    ],
+)
+def test_negative_comma_separated_values_follow_their_option(argv, expected):
+    args = build_parser().parse_args(argv)
+    assert {name: getattr(args, name) for name in expected} == expected
+
+
+def test_attach_negative_values_leaves_other_tokens_and_the_end_of_options():
+    argv = ["navigate", "--start", "-1,2,0", "--degrees", "--goal=-3,4", "plan.npz", "--", "--x", "-1,2"]
+    assert attach_negative_values(argv) == [
+        "navigate",
+        "--start=-1,2,0",
+        "--degrees",
+        "--goal=-3,4",
+        "plan.npz",
+        "--",
+        "--x",
+        "-1,2",
+    ]
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,1 @@
+"""Whole-body motions from contact plans, executed by Talos in MuJoCo physics (host code)."""

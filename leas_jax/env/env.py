@@ -23,6 +23,7 @@ with contextlib.redirect_stdout(io.StringIO()):
 from leas_jax.env import condition, heightmap, kinematics, reward
 from leas_jax.env.config import EnvConfig
 from leas_jax.env.field import Heightfield, heightfield_from_terrain, sample_bilinear
+from leas_jax.errors import TerrainError
 from leas_jax.terrain.model import Terrain
 
 
@@ -146,7 +147,15 @@ class LeasEnv(Env):
 
         One uniform draw feeds every random quantity (each threefry call
         costs about as much as a reachability test on a CPU).
+
+        Raises:
+            TerrainError: the field has no spawn points (when traced: its shape says so).
         """
+        if self.field.spawn_xy.shape[0] == 0:
+            raise TerrainError(
+                "random resets start at the field's spawn points and it has none (the terrain is too "
+                "small or too rough); start rollouts from given poses (`reset_to`) instead"
+            )
         cfg = self.config
         next_rng, key = jax.random.split(rng)
         n = cfg.reset_attempts

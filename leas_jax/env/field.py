@@ -19,6 +19,7 @@ from scipy import ndimage
 
 from leas_jax.env.config import EnvConfig, ReachabilityConfig
 from leas_jax.env.learned_weights import condition_params
+from leas_jax.errors import TerrainError
 
 
 @struct.dataclass
@@ -43,6 +44,8 @@ class Heightfield:
         spawn_xy: [S, 2] world (x, y) of the reset positions: grid points where a root at
             nominal height is valid for every yaw (resets draw around them), or, where
             `spawn_yaw` is set, positions of verified start poses (resets use them as they are).
+            S is 0 on a terrain with no such point (too small or too rough): the field then
+            serves rollouts from given starts, not random resets (`LeasEnv.random_root`).
         spawn_yaw: [S] yaw (rad, world) of each verified start pose; NaN where any yaw is
             valid (`EnvConfig.spawns`: "condition" gives NaN everywhere, "generator" none).
         spawn_spacing: [] spacing of the spawn candidates (m); resets jitter within it.
@@ -273,7 +276,8 @@ def heightfield_from_raster(
         config: environment configuration (cylinder radii, nominal root height).
         spawn_spacing: spacing of reset candidates (m).
         require_spawn: raise ValueError when no point is valid for a reset; with
-            False the grid centre stands in (for fields used only for sampling).
+            False the field then has no spawn points (for fields used only for sampling
+            and for rollouts from given starts).
     """
     heights = np.asarray(heights, dtype=np.float32)
     reach: ReachabilityConfig = config.reachability
@@ -296,10 +300,8 @@ def heightfield_from_raster(
         else disk_filter(heights, reach.hand_radius / resolution, "max", void_height)
     )
     spawn_ij = _spawn_points(heights, trunk_max, void_height, resolution, config, spawn_spacing, foothold)
-    if len(spawn_ij) == 0:
-        if require_spawn:
-            raise ValueError("the terrain has no valid spawn position for the root at nominal height")
-        spawn_ij = np.array([[heights.shape[0] // 2, heights.shape[1] // 2]])
+    if len(spawn_ij) == 0 and require_spawn:
+        raise ValueError("the terrain has no valid spawn position for the root at nominal height")
     spawn_xy = np.asarray(origin, dtype=np.float32) + spawn_ij.astype(np.float32) * resolution
     f32 = lambda a: jnp.asarray(a, dtype=jnp.float32)  # noqa: E731
     return Heightfield(
@@ -320,9 +322,28 @@ def heightfield_from_raster(
 
 
 def heightfield_from_terrain(
-    terrain, config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10
+    terrain, config: EnvConfig = EnvConfig(), spawn_spacing: float = 0.10, require_spawn: bool = False
 ) -> Heightfield:
-    """Heightfield of a `leas_jax.terrain.Terrain` (host only, not jittable)."""
-    return heightfield_from_raster(
-        terrain.raster(), terrain.bounds[0], terrain.resolution, terrain.void_height, config, spawn_spacing
+    """Heightfield of a `leas_jax.terrain.Terrain` (host only, not jittable).
+
+    Only random resets (training, `LeasEnv.reset`) start at spawn points; rollouts, the
+    navigate search and the evaluations start where they are told. So by default a terrain
+    with no spawn point (too small for a root valid at every yaw) gives a field without
+    any, and `require_spawn` (the training arena, `feasibility.spawns.arena_field`) turns
+    that into a TerrainError naming the terrain file.
+    """
+    field = heightfield_from_raster(
+        terrain.raster(),
+        terrain.bounds[0],
+        terrain.resolution,
+        terrain.void_height,
+        config,
+        spawn_spacing,
+        require_spawn=False,
     )
+    if require_spawn and field.spawn_xy.shape[0] == 0:
+        raise TerrainError(
+            f"{terrain.path or terrain.name}: no spawn position, a point where a root at nominal height "
+            "is valid for every yaw, for training episodes to start at (the terrain is too small or too rough)"
+        )
+    return field

@@ -155,7 +155,8 @@ def verified_spawns(field, terrain, config, generator_config=None, workers=None,
 
 def arena_field(terrain, config, workers=None, progress=True):
     """The `Heightfield` random resets start on: the terrain's, with verified spawns when
-    `config.spawns` is "generator" (host only; see `verified_spawns`)."""
+    `config.spawns` is "generator" (host only; see `verified_spawns`). Raises TerrainError,
+    naming the terrain file, when the terrain has no spawn point."""
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.errors import UsageError
 
@@ -163,7 +164,7 @@ def arena_field(terrain, config, workers=None, progress=True):
         raise UsageError(f"EnvConfig.spawns must be one of {', '.join(SPAWN_MODES)}, got {config.spawns!r}")
     if not (isinstance(config.spawn_yaws, int) and config.spawn_yaws >= 1):
         raise UsageError(f"EnvConfig.spawn_yaws must be an integer >= 1, got {config.spawn_yaws!r}")
-    field = heightfield_from_terrain(terrain, config)
+    field = heightfield_from_terrain(terrain, config, require_spawn=True)
     if config.spawns == "generator":
         field = verified_spawns(field, terrain, config, workers=workers, progress=progress)
     return field

@@ -223,9 +223,10 @@ def main(argv=None) -> dict:
     from reachability_validation import rates
 
     from leas_jax.env import heightfield_from_terrain
-    from leas_jax.env.learned_weights import load_params, resolve_weights, save_params
+    from leas_jax.env.learned_weights import load_params, save_params
     from leas_jax.feasibility import FitConfig, features_of, fit, predict
     from leas_jax.feasibility.spawns import arena_field
+    from leas_jax.files import resolve_data_path
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import learned_condition_env
     from leas_jax.training.planner import VERDICT_HORIZON, anchor_samples, verdict_samples
@@ -238,7 +239,7 @@ def main(argv=None) -> dict:
     learned_env = learned_condition_env(teachers[0].config.env, args.weights)
     field = heightfield_from_terrain(arena, learned_env)
     reach = learned_env.reachability
-    base, base_meta = load_params(resolve_weights(args.weights))
+    base, base_meta = load_params(resolve_data_path(args.weights))
     out = Path(args.out)
     planned = {
         path: plan_teacher_guides(

@@ -49,8 +49,8 @@ def main(argv=None) -> dict:
     load_before = load_average()
 
     from leas_jax.env import heightfield_from_terrain
+    from leas_jax.files import resolve_data_path
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
 
     env = load_policy(args.policy).config.env

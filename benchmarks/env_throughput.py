@@ -157,8 +157,9 @@ def measure(field, config, num_envs: int, steps: int, repeats: int) -> dict:
 
 def main(argv=None) -> None:
     from leas_jax.env import EnvConfig, heightfield_from_terrain
+    from leas_jax.files import resolve_data_path
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import learned_condition_env, preset, resolve_data_path
+    from leas_jax.training.config import learned_condition_env, preset
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--terrain", default="terrains/training_arena.toml")

@@ -172,6 +172,7 @@ def main(argv=None) -> None:
     from leas_jax.env import EnvConfig, ReachabilityConfig, heightfield_from_terrain
     from leas_jax.env import learned_feasibility as lf
     from leas_jax.feasibility import FitConfig, features_of, fit, predict
+    from leas_jax.files import resolve_data_path
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import TRAINING_REACHABILITY
     from leas_jax.training.policy import load_policy
@@ -206,7 +207,7 @@ def main(argv=None) -> None:
     parser.add_argument("--out", default=None, help="directory for the JSON and markdown report")
     args = parser.parse_args(argv)
     for other in args.compare_weights:
-        if not lf.resolve_weights(other).is_file():
+        if not resolve_data_path(other).is_file():
             parser.error(f"--compare-weights {other}: no such file")
     for name in ("train_poses", "test_poses"):
         if getattr(args, name) < 1:
@@ -238,7 +239,7 @@ def main(argv=None) -> None:
     from leas_jax.contacts.planner.generator import GeneratorConfig
 
     key = dataset_key(terrain.text, GeneratorConfig())
-    weights = lf.resolve_weights(args.weights)
+    weights = resolve_data_path(args.weights)
     lf.save_params(
         weights,
         params,
@@ -251,7 +252,7 @@ def main(argv=None) -> None:
     )
     print(f"wrote {weights} (fit {info['fit_seconds']} s, threshold {info['threshold']:.3f})")
 
-    compared = {name: lf.load_params(lf.resolve_weights(name))[0] for name in args.compare_weights}
+    compared = {name: lf.load_params(resolve_data_path(name))[0] for name in args.compare_weights}
     validation = {}
     for set_name in ("fresh", "policy"):
         poses, truth = sets[set_name]

@@ -215,8 +215,8 @@ def evaluate_policy(run_dir: Path, args) -> dict:
     from leas_jax.contacts.validation.pool import validate_paths
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.eval.geometric import arena_episodes, ground_speed
+    from leas_jax.files import resolve_data_path
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
 
     policy = load_policy(run_dir)  # with a DAgger run's own refreshed condition

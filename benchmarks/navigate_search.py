@@ -44,12 +44,13 @@ def main() -> None:
     args = parser.parse_args()
 
     from leas_jax.env import heightfield_from_terrain
-    from leas_jax.eval.scenarios import cells_for, draw_starts, scenario_file
+    from leas_jax.eval.scenarios import cells_for, draw_starts
     from leas_jax.navigate.lattice import build_lattice
     from leas_jax.navigate.search import SearchConfig, graph, search
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.steering.rrt import RRTConfig, plan_rrt
     from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
     from leas_jax.training import load_policy
 
     policy = load_policy("checkpoints/leas_talos")

@@ -330,9 +330,10 @@ def main(argv=None) -> None:
 
     from leas_jax.contacts import GeneratorConfig
     from leas_jax.env import EnvConfig, heightfield_from_terrain
-    from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for, scenario_file
+    from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
 
     load_before = load_average()
     began = time.perf_counter()

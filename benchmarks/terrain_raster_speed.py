@@ -116,9 +116,10 @@ def elevation_case(samples: int, folder: Path) -> dict:
 def mesh_twin(terrain, folder: Path):
     """The terrain's boxes exported to STL and loaded back as a one-mesh terrain."""
     from leas_jax.terrain import loads_terrain
+    from leas_jax.terrain.export import export_terrain
 
     stl = folder / f"{terrain.name}.stl"
-    terrain.export(stl)
+    export_terrain(terrain, stl)
     head = terrain.text.split("[[box]]", 1)[0]
     lines = [line for line in head.splitlines() if not line.startswith("#")]
     text = "\n".join(lines) + f'\n[[mesh]]\nfile = "{stl.name}"\n'

@@ -1,7 +1,9 @@
-"""Atomic file writes: readers see the old file or the new one, never a partial one.
+"""Files: the repository's data files, and atomic writes (readers see the old file or the new one,
+never a partial one).
 
 Host only. Every file the package writes (checkpoints, policies, guides, plans,
-reports) goes through `atomic_write_bytes`.
+reports) goes through `atomic_write_bytes`; data files named relative to the repository
+(terrains, condition weights) are found through `resolve_data_path`.
 """
 
 from __future__ import annotations
@@ -9,6 +11,19 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+
+
+def resolve_data_path(path: str | Path) -> Path:
+    """A data file (terrain, weights) as given if it exists, else relative to the repository root.
+
+    Lets `terrains/training_arena.toml` work from any working directory.
+    """
+    path = Path(path)
+    if path.exists() or path.is_absolute():
+        return path
+    return REPO_ROOT / path
 
 
 def _umask() -> int:

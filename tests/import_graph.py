@@ -1,11 +1,11 @@
 """The import graph of the leas_jax package, from its source (ast; nothing is imported).
 
-Every `import` and `from ... import` of a leas_jax module counts, at module level or inside
-a function (a lazy import is still a dependency). `from package import name` is an edge to
-the submodule `package.name` when there is one, else to the package. Importing a submodule
-implicitly runs its parents' `__init__`; those implicit edges are left out (they would make
-every package a cycle with its own submodules), and so are the imports under
-`if TYPE_CHECKING:` (annotations only, never run).
+Every `import` and `from ... import` of a leas_jax module counts, at module level, inside
+a function (a lazy import is still a dependency) or under `if TYPE_CHECKING:` (two modules
+whose annotations name each other still know each other). `from package import name` is an
+edge to the submodule `package.name` when there is one, else to the package. Importing a
+submodule implicitly runs its parents' `__init__`; those implicit edges are left out (they
+would make every package a cycle with its own submodules).
 
     python tests/import_graph.py          # prints each cycle, exit 1 if there is one
 """
@@ -40,35 +40,12 @@ def _resolve(module: str, is_package: bool, level: int, target: str | None) -> s
     return ".".join(base + ([target] if target else []))
 
 
-def _type_checking(node: ast.AST) -> bool:
-    """Whether `node` is `if TYPE_CHECKING:` (or `if typing.TYPE_CHECKING:`)."""
-    if not isinstance(node, ast.If):
-        return False
-    test = node.test
-    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
-        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING"
-    )
-
-
-def _run_nodes(tree: ast.AST):
-    """Every node of `tree` except those inside `if TYPE_CHECKING:` bodies."""
-    pending = [tree]
-    while pending:
-        node = pending.pop()
-        yield node
-        for child in ast.iter_child_nodes(node):
-            if _type_checking(child):
-                pending.extend(child.orelse)
-            else:
-                pending.append(child)
-
-
 def imports(name: str, path: Path, known: dict[str, Path]) -> set[str]:
     """The leas_jax modules that module `name` (file `path`) imports."""
     tree = ast.parse(path.read_text(), filename=str(path))
     is_package = path.name == "__init__.py"
     out = set()
-    for node in _run_nodes(tree):
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for alias in node.names:
                 if alias.name in known:
@@ -88,6 +65,17 @@ def graph(root: Path = ROOT) -> dict[str, set[str]]:
     """{module: modules it imports} over the whole package."""
     known = modules(root)
     return {name: imports(name, path, known) for name, path in known.items()}
+
+
+def reached(edges: dict[str, set[str]], prefix: str) -> set[str]:
+    """The modules named `prefix`... and every module they import, directly or not."""
+    found, pending = set(), [m for m in edges if m == prefix or m.startswith(prefix + ".")]
+    while pending:
+        module = pending.pop()
+        if module not in found:
+            found.add(module)
+            pending.extend(edges[module])
+    return found
 
 
 def cycles(edges: dict[str, set[str]]) -> list[list[str]]:

@@ -18,8 +18,8 @@ import pytest
 from leas_jax.env import EnvConfig, LeasEnv, heightfield_from_terrain
 from leas_jax.env.field import sample_bilinear
 from leas_jax.env.heightmap import sample
+from leas_jax.files import resolve_data_path
 from leas_jax.terrain import load_terrain
-from leas_jax.training.config import resolve_data_path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 
@@ -274,8 +274,9 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     import table2_baselines as table2
 
     from leas_jax.contacts import GeneratorConfig
-    from leas_jax.eval.scenarios import cells_for, scenario_file
+    from leas_jax.eval.scenarios import cells_for
     from leas_jax.steering.baselines import BaselineConfig
+    from leas_jax.terrain.generate import scenario_file
 
     assert GeneratorConfig().planning_stride(0.01) == 50 and GeneratorConfig().planning_stride(0.1) == 5
     terrain = load_terrain(scenario_file("ground"))

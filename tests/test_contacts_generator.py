@@ -329,8 +329,8 @@ def test_slow_leas_climb_of_eval_stairs_is_covered():
     the top platform): it climbs at ~0.06 m/s with its root rising tread by tread. With a
     0.10 m step trigger the trailing foot stayed a tread lower until its leg was
     overstretched, and the plan stopped at 69 % of the guide."""
-    from leas_jax.eval.scenarios import scenario_file
     from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
 
     data = np.load(Path(__file__).parent / "data" / "eval_stairs_slow_leas_guide.npz")
     plan = plan_contacts(load_terrain(scenario_file("stairs")), data["guide"], float(data["timestep"]))
@@ -345,8 +345,8 @@ def test_the_foot_that_can_lead_steps_first_beside_a_void():
     doing so while the left foot never moved; at x = 3.87 both feet then lagged out of reach
     (last valid index 230). Steps that bring a foot nearer its target come first now: the
     left foot leads, the right follows, and the whole guide is covered."""
-    from leas_jax.eval.scenarios import scenario_file
     from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
 
     data = np.load(Path(__file__).parent / "data" / "eval_bridge_sidestep_leas_guide.npz")
     bridge = load_terrain(scenario_file("bridge"))
@@ -422,8 +422,8 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
     the stance sole, which a slab's edge put 4 cm from the guide's line instead of 8.5 cm):
     held under its hip, the lifted foot met the stance shin at every root shift and the
     plan stopped at pose 160; held `swing_clearance` farther out, it passes."""
-    from leas_jax.eval.scenarios import scenario_file
     from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
 
     data = np.load(Path(__file__).parent / "data" / "eval_circuit_slabs_leas_guide.npz")
     circuit = load_terrain(scenario_file("circuit"))

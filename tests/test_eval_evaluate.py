@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from leas_jax.cli import main
-from leas_jax.eval import metrics
+from leas_jax.contacts import metrics
 from leas_jax.eval.scenarios import PAPER_TABLE_II, cells_for
 
 # 4.5 x 3.5 m floor, a wall across x = 2.2 from y = 0 to y = 2 (the RRT goes round it),
@@ -145,7 +145,7 @@ def test_ground_runs_table_ii_cells():
     ],
 )
 def test_usage_errors_are_one_line(capsys, tmp_path, monkeypatch, argv, fragment):
-    from leas_jax.training.config import REPO_ROOT
+    from leas_jax.files import REPO_ROOT
 
     monkeypatch.chdir(REPO_ROOT if "training_arena" in " ".join(argv) else tmp_path)
     code = main(argv)
@@ -206,7 +206,7 @@ def test_rrt_searches_are_the_same_in_worker_processes():
 
 
 def test_leas_horizon_scales_with_the_route_and_keeps_the_minimum():
-    from leas_jax.eval.scenarios import HORIZON_FACTOR, leas_horizon
+    from leas_jax.steering.horizon import HORIZON_FACTOR, leas_horizon
 
     # 6 m at 0.18 m/s and 0.1 s per step: 333.3 steps at the target speed.
     points = np.array([[6.0, 0.0]])

@@ -6,7 +6,7 @@ from pathlib import Path
 import nbformat
 from nbclient import NotebookClient
 
-from leas_jax.training.config import REPO_ROOT
+from leas_jax.files import REPO_ROOT
 
 NOTEBOOKS = REPO_ROOT / "notebooks"
 FLAT_SCENARIO = """name = "flat_scenario"

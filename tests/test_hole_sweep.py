@@ -8,8 +8,8 @@ import pytest
 from leas_jax.cli import main
 from leas_jax.errors import UsageError
 from leas_jax.eval.sweeps import hole_terrain, hole_width_sweep, parse_widths
+from leas_jax.files import REPO_ROOT
 from leas_jax.terrain import load_terrain
-from leas_jax.training.config import REPO_ROOT
 
 
 def test_the_default_width_is_eval_hole():

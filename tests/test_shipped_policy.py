@@ -10,8 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
+from leas_jax.files import REPO_ROOT
 from leas_jax.training import load_policy, preset
-from leas_jax.training.config import REPO_ROOT, learned_condition_env, pretraining_config
+from leas_jax.training.config import learned_condition_env, pretraining_config
 
 SHIPPED = REPO_ROOT / "checkpoints" / "leas_talos"
 

@@ -8,6 +8,7 @@ import pytest
 import trimesh
 
 from leas_jax.terrain import Box, SupportSurface, Terrain, TerrainError, loads_terrain
+from leas_jax.terrain.export import export_terrain, terrain_to_mesh, terrain_to_mjcf
 
 
 def make_terrain(boxes, bounds=((0.0, 0.0), (1.0, 1.0)), resolution=0.1, void_height=-2.0):
@@ -297,7 +298,7 @@ rpy = [0.1, -0.2, 0.7]
 
 def test_mjcf_has_one_box_geom_per_box():
     terrain = loads_terrain(EXPORT_TEXT)
-    model = mujoco.MjModel.from_xml_string(terrain.to_mjcf())
+    model = mujoco.MjModel.from_xml_string(terrain_to_mjcf(terrain))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     assert model.ngeom == 2
@@ -311,7 +312,7 @@ def test_mjcf_has_one_box_geom_per_box():
 
 def test_mesh_has_the_boxes():
     terrain = loads_terrain(EXPORT_TEXT)
-    mesh = terrain.to_mesh()
+    mesh = terrain_to_mesh(terrain)
     assert isinstance(mesh, trimesh.Trimesh)
     assert mesh.vertices.shape == (16, 3) and mesh.faces.shape == (24, 3)
     # disjoint boxes: volume 2 x 2 x 0.2 + 0.6 x 0.8 x 0.2 = 0.8 + 0.096
@@ -333,7 +334,7 @@ def test_mesh_has_the_boxes():
 def test_export_by_extension(tmp_path, suffix):
     terrain = loads_terrain(EXPORT_TEXT)
     path = tmp_path / f"terrain{suffix}"
-    terrain.export(path)
+    export_terrain(terrain, path)
     assert path.stat().st_size > 0
     if suffix == ".xml":
         assert mujoco.MjModel.from_xml_path(str(path)).ngeom == 2
@@ -344,4 +345,4 @@ def test_export_by_extension(tmp_path, suffix):
 
 def test_export_rejects_unknown_extension(tmp_path):
     with pytest.raises(TerrainError, match=r"unknown export format '\.ply'"):
-        loads_terrain(EXPORT_TEXT).export(tmp_path / "terrain.ply")
+        export_terrain(loads_terrain(EXPORT_TEXT), tmp_path / "terrain.ply")

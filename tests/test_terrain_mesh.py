@@ -14,6 +14,7 @@ import trimesh
 
 from leas_jax.terrain import TerrainError, load_terrain, loads_terrain
 from leas_jax.terrain import sources as terrain_sources
+from leas_jax.terrain.export import export_terrain, terrain_to_mesh, terrain_to_mjcf
 
 REPO = Path(__file__).resolve().parents[1]
 BOX_TERRAINS = sorted(p for p in (REPO / "terrains").glob("*.toml") if "[[box]]" in p.read_text()) + [
@@ -35,7 +36,7 @@ def _area(surface) -> float:
 
 def _twin(terrain, folder: Path, transform=None, name="twin", **mesh_keys):
     """The terrain's boxes as one STL `[[mesh]]` terrain (vertices optionally mapped by `transform`)."""
-    mesh = terrain.to_mesh()
+    mesh = terrain_to_mesh(terrain)
     if transform is not None:
         mesh = transform(mesh)
     mesh.export(folder / f"{name}.stl")
@@ -102,7 +103,7 @@ def test_raster_matches_mujoco_ray_cast():
     import mujoco
 
     terrain = load_terrain(REPO / "terrains" / "hpp" / "rubble.toml")
-    model = mujoco.MjModel.from_xml_string(terrain.to_mjcf())
+    model = mujoco.MjModel.from_xml_string(terrain_to_mjcf(terrain))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     xs, ys = terrain.grid_axes()
@@ -347,9 +348,9 @@ def test_exports_and_collision_objects(tmp_path):
     from leas_jax.contacts.robot.collision import terrain_collision
 
     terrain = _twin(loads_terrain(STEP), tmp_path)
-    mujoco.MjModel.from_xml_string(terrain.to_mjcf())
+    mujoco.MjModel.from_xml_string(terrain_to_mjcf(terrain))
     for suffix in (".glb", ".stl", ".xml"):
-        terrain.export(tmp_path / f"out{suffix}")
+        export_terrain(terrain, tmp_path / f"out{suffix}")
         assert (tmp_path / f"out{suffix}").stat().st_size > 0
     assert len(trimesh.load(tmp_path / "out.stl", force="mesh").faces) == len(terrain.meshes[0].faces)
     objects = terrain_collision(terrain)

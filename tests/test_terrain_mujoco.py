@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from leas_jax.terrain import Terrain, load_terrain
+from leas_jax.terrain.export import terrain_to_mjcf
 
 TERRAINS = Path(__file__).resolve().parents[1] / "terrains"
 NAMES = sorted(p.stem for p in TERRAINS.glob("*.toml"))
@@ -101,7 +102,7 @@ def sample_points(terrain: Terrain, seed: int = 0) -> np.ndarray:
 
 
 def mujoco_scene(terrain: Terrain):
-    model = mujoco.MjModel.from_xml_string(terrain.to_mjcf())
+    model = mujoco.MjModel.from_xml_string(terrain_to_mjcf(terrain))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     return model, data

@@ -11,7 +11,8 @@ docs/design.md §6 fixes the contract; docs/architecture.md the interface:
 Sub-packages, in the order a guide meets them:
 robot (Talos model, IK, collision, equilibrium, sample database), planner (support
 surfaces, the generator), validation (worker pool, Ray backend). Beside them: plan
-(ContactPlan file format), verify, viewer, commands (CLI).
+(ContactPlan file format), verify, metrics (a plan's coverage and success on its guide),
+viewer, commands (CLI).
 Attributes are imported lazily so that `import leas_jax.contacts` stays cheap.
 """
 

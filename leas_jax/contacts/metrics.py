@@ -1,4 +1,6 @@
-"""Per-trajectory metrics of docs/design.md §8 and their aggregates.
+"""How far a guide's contact plan got: the metrics of docs/design.md §8 and their aggregates.
+
+The evaluation and navigate both judge a guide by them. Host code (NumPy).
 
 coverage: arc-length fraction of the guide covered by the contact plan (the
     generator's `coverage`; Table II's "success rate").

@@ -302,8 +302,10 @@ def html_payload(
     robot {geoms [{mesh, color}], postures [P] (plan indices), guide_index
     [P], matrices f32 [P*G*12] row-major 3x4}.
     """
+    from leas_jax.terrain.export import terrain_to_mesh
+
     terrain = _terrain_of(plan)
-    mesh = terrain.to_mesh()
+    mesh = terrain_to_mesh(terrain)
     guide = np.asarray(plan.guide, dtype=np.float64)
     feet_by_foot = {0: [], 1: []}
     for foot, _, corners in footprints(plan):

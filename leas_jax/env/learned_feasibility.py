@@ -40,7 +40,6 @@ from leas_jax.env.learned_weights import (  # noqa: F401 (the weights' file API,
     LearnedParams,
     load_params,
     margin_count,
-    resolve_weights,
     save_params,
     with_ground_index,
 )

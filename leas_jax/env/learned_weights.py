@@ -16,12 +16,12 @@ import jax.numpy as jnp
 import numpy as np
 
 from leas_jax.env.config import EnvConfig, ReachabilityConfig
+from leas_jax.files import resolve_data_path
 
 LAYER_KEYS = ("w0", "b0", "w1", "b1", "w2", "b2")
 # m, the local ground is the highest terrain point within this radius of the root (the pose
 # sampler's reference ground uses 0.15 m; grid points within it at a 0.08 m spacing: 13)
 GROUND_RADIUS = 0.17
-REPO_ROOT = Path(__file__).resolve().parents[2]
 
 LearnedParams = dict  # str -> jax.Array (see `learned_feasibility.init_params` for the keys and shapes)
 
@@ -35,13 +35,6 @@ def margin_count(reach: ReachabilityConfig) -> int:
         + (legs if reach.foothold_spread is not None else 0)
         + (2 if reach.hand_radius is not None else 0)
     )
-
-
-def resolve_weights(path: str | Path) -> Path:
-    """A weights file as given if it exists, else relative to the repository root (the rule of
-    `training.config.resolve_data_path`, which the env cannot import: training imports env)."""
-    path = Path(path)
-    return path if path.exists() or path.is_absolute() else REPO_ROOT / path
 
 
 def ground_index(grid) -> np.ndarray:
@@ -95,7 +88,7 @@ def condition_params(config: EnvConfig) -> dict:
         return {}
     if config.condition != "learned":
         raise ValueError(f"EnvConfig.condition must be 'cylinders' or 'learned', got {config.condition!r}")
-    path = resolve_weights(config.learned_weights)
+    path = resolve_data_path(config.learned_weights)
     params, metadata = load_params(path)
     features = len(params["grid"]) + 1 + margin_count(config.reachability)
     if params["mean"].shape != (features,):

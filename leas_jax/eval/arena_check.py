@@ -60,8 +60,8 @@ def arena_check(
         ground_speed,
     )
     from leas_jax.feasibility.spawns import arena_field
+    from leas_jax.files import resolve_data_path
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
 
     if episodes < 1:

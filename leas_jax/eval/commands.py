@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from leas_jax.errors import UsageError
-from leas_jax.eval.scenarios import METHODS, SCENARIOS
+from leas_jax.eval.scenarios import METHODS
+from leas_jax.terrain.generate import SCENARIOS
 from leas_jax.terrain.loader import MAX_STARTS
 
 

@@ -33,22 +33,21 @@ from pathlib import Path
 
 import numpy as np
 
+from leas_jax.contacts import metrics
 from leas_jax.errors import UsageError
-from leas_jax.eval import metrics
 from leas_jax.eval.scenarios import (
     DEFAULT_METHODS,
     LEAS_METHODS,
     METHODS,
     RRT_METHODS,
-    SCENARIOS,
     Cell,
     Starts,
     cells_for,
     draw_starts,
-    leas_horizon,
     route,
-    scenario_file,
 )
+from leas_jax.steering.horizon import leas_horizon
+from leas_jax.terrain.generate import SCENARIOS, scenario_file
 
 
 @dataclass

@@ -69,9 +69,9 @@ def _geometric_section(run_dir: Path, out: Path, n_episodes: int) -> tuple[list[
         ground_speed,
     )
     from leas_jax.feasibility.spawns import arena_field
+    from leas_jax.files import resolve_data_path
     from leas_jax.plotting import plot_paths
     from leas_jax.terrain import load_terrain
-    from leas_jax.training.config import resolve_data_path
     from leas_jax.training.policy import load_policy
 
     policy = load_policy(run_dir)

@@ -10,13 +10,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from leas_jax.errors import UsageError
 
-SCENARIOS = ("ground", "hole", "bridge", "stairs", "stairs_side", "circuit")
 METHODS = ("rblin", "rbkino", "rbkino_rrt", "leas", "leas_rrt", "navigate")
 LEAS_METHODS = ("leas", "leas_rrt", "navigate")
 RRT_METHODS = ("rbkino_rrt", "leas_rrt")
@@ -83,17 +81,6 @@ class Starts:
     poses: np.ndarray
     speeds: np.ndarray
     yaw_offsets_deg: np.ndarray
-
-
-def scenario_file(name: str) -> Path:
-    """terrains/eval_<name>.toml, resolved from the repository root."""
-    from leas_jax.training.config import resolve_data_path
-
-    if name not in SCENARIOS:
-        raise UsageError(
-            f"--scenario: unknown scenario {name!r} (expected one of {', '.join(SCENARIOS)}, all)"
-        )
-    return resolve_data_path(f"terrains/eval_{name}.toml")
 
 
 def cells_for(name: str, scenario) -> list[Cell]:
@@ -196,26 +183,3 @@ def check_target(scenario, field, nominal_root_height: float, reachability) -> N
             f"scenario.target ({x:g}, {y:g}): the robot cannot stand there at any yaw (inside an "
             "obstacle, against a wall or over the void: the reachability condition fails)"
         )
-
-
-# LeaS horizon / time to walk the route at the target speed. The horizon bounds how long
-# LeaS may take, it is not a metric: the policy slows to ~0.06 m/s on eval_stairs, and
-# with 1.5 (the first choice) 13 of 30 stairs guides were cut 0.3-0.8 m before the
-# target with their whole length covered by the contact plan.
-HORIZON_FACTOR = 2.5
-
-
-def leas_horizon(
-    start_xy, points, target_speed: float, timestep: float, minimum: int, factor: float = HORIZON_FACTOR
-) -> int:
-    """LeaS horizon (steps) for a route: `factor` x the time to walk it at the target speed,
-    >= `minimum`.
-
-    The paper's episodes last 400 steps (40 s, 7.2 m at 0.18 m/s); the bridge and
-    circuit routes are longer, so the horizon grows with the route length.
-    """
-    polyline = np.concatenate(
-        [np.asarray(start_xy, np.float64).reshape(1, 2), np.asarray(points).reshape(-1, 2)]
-    )
-    length = float(np.sum(np.hypot(*np.diff(polyline, axis=0).T)))
-    return max(int(minimum), int(math.ceil(factor * length / (target_speed * timestep))))

@@ -239,7 +239,7 @@ class Navigator:
 
     def _rollout(self, poses: np.ndarray, speeds: np.ndarray, waypoints: list) -> list[np.ndarray]:
         """Guides of the policy from poses [N, 4] along each waypoint list [W_n, 2] (one jitted batch)."""
-        from leas_jax.eval.scenarios import leas_horizon
+        from leas_jax.steering.horizon import leas_horizon
         from leas_jax.steering.leas import rollout_batch
 
         cfg = self.config
@@ -352,7 +352,7 @@ class Navigator:
 
     def _after_validation(self, k: int, state: _State, result) -> np.ndarray | None:
         """Record the generator's answer on the state's guide; return the next guide or None (done)."""
-        from leas_jax.eval import metrics
+        from leas_jax.contacts import metrics
 
         guide, query, cfg = state.guide, state.query, self.config
         state.seconds["contact_planning"] += float(result.seconds)

@@ -32,9 +32,9 @@ def navigate_section(
         (markdown lines, summary dict).
     """
     from leas_jax.contacts.viewer import write_footsteps_png
-    from leas_jax.eval.scenarios import scenario_file
     from leas_jax.navigate.loop import navigate
     from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
     from leas_jax.training import load_policy
 
     terrain = load_terrain(terrain_file or scenario_file(scenario))

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from leas_jax.errors import UsageError
-from leas_jax.terrain.export import EXPORT_EXTENSIONS
+from leas_jax.terrain.export import EXPORT_EXTENSIONS, export_terrain
 from leas_jax.terrain.loader import load_terrain
 
 
@@ -104,8 +104,7 @@ def cmd_export(args: argparse.Namespace) -> None:
             f"terrain export: --out {args.out}: unknown format "
             f"{out.suffix or '(no extension)'!r}, use one of {', '.join(EXPORT_EXTENSIONS)}"
         )
-    terrain = load_terrain(args.file)
-    terrain.export(out)
+    export_terrain(load_terrain(args.file), out)
     print(f"wrote {out}")
 
 

@@ -9,15 +9,12 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
-from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from leas_jax.errors import TerrainError
-
-if TYPE_CHECKING:  # annotations only: the model's methods call this module
-    from leas_jax.terrain.model import Terrain
+from leas_jax.terrain.model import Terrain
 
 MESH_EXTENSIONS = (".glb", ".obj", ".stl")
 EXPORT_EXTENSIONS = (".xml",) + MESH_EXTENSIONS

@@ -19,8 +19,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+
+from leas_jax.errors import UsageError
+from leas_jax.files import resolve_data_path
 
 ARENA_CELLS = 10  # cells per side, paper §IV-A ("10x10 grid")
 CELL = 2.0  # m, cell side: 20 x 20 m arena, paper §IV-A
@@ -757,6 +761,17 @@ _EVAL_BUILDERS = {
     "eval_stairs_side": _eval_stairs_side,
     "eval_circuit": _eval_circuit,
 }
+# The evaluation scenarios, each the [scenario] table of terrains/eval_<name>.toml.
+SCENARIOS = tuple(name.removeprefix("eval_") for name in _EVAL_BUILDERS)
+
+
+def scenario_file(name: str) -> Path:
+    """terrains/eval_<name>.toml of a scenario of `SCENARIOS`, resolved from the repository root."""
+    if name not in SCENARIOS:
+        raise UsageError(
+            f"--scenario: unknown scenario {name!r} (expected one of {', '.join(SCENARIOS)}, all)"
+        )
+    return resolve_data_path(f"terrains/eval_{name}.toml")
 
 
 def generate_eval_terrains() -> dict[str, str]:

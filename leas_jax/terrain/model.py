@@ -1,9 +1,9 @@
-"""Terrain data model: boxes and meshes over a void, their heightfield, support surfaces and exports.
+"""Terrain data model: boxes and meshes over a void, their heightfield and support surfaces.
 
 Host code (NumPy); nothing here can be jitted. The file format is docs/design.md §4 (terrain
 format v1; v2 adds meshes and an elevation map, `leas_jax.terrain.sources`, whose geometry
-is `leas_jax.terrain.mesh`); the interface is docs/architecture.md. All coordinates are
-world frame, metres, z up.
+is `leas_jax.terrain.mesh`); the interface is docs/architecture.md; `leas_jax.terrain.export`
+writes a terrain as MJCF or a mesh. All coordinates are world frame, metres, z up.
 """
 
 from __future__ import annotations
@@ -444,30 +444,6 @@ class Terrain:
         for index, box in enumerate(self.boxes):
             covered |= box.contains(points) & (owner != index)
         return covered
-
-    def to_mjcf(self) -> str:
-        """MuJoCo scene of the terrain: one `<geom type="box">` per box, one mesh geom per mesh.
-
-        Returns:
-            MJCF XML text; geoms are named box0, box1, ... in box order, `size` is the half
-            extents and `quat` the orientation in MuJoCo's (w, x, y, z) order; meshes are
-            mesh0, mesh1, ... with their world-frame vertices inline.
-        """
-        from leas_jax.terrain.export import terrain_to_mjcf
-
-        return terrain_to_mjcf(self)
-
-    def to_mesh(self):
-        """trimesh.Trimesh of all boxes (12 triangles each) then all meshes' triangles, world frame."""
-        from leas_jax.terrain.export import terrain_to_mesh
-
-        return terrain_to_mesh(self)
-
-    def export(self, path) -> None:
-        """Write the terrain by file extension: .xml (MJCF), .glb, .obj, .stl (mesh)."""
-        from leas_jax.terrain.export import export_terrain
-
-        export_terrain(self, path)
 
 
 class _PointTiles:

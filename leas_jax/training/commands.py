@@ -180,11 +180,11 @@ def config_from_args(args):
         raise UsageError("--condition-weights is for --reachability learned")
     if args.reachability == "learned":
         from leas_jax.env.config import EnvConfig
-        from leas_jax.env.learned_weights import resolve_weights
+        from leas_jax.files import resolve_data_path
 
         if weights is None:
             weights = EnvConfig.learned_weights
-        elif not resolve_weights(weights).is_file():
+        elif not resolve_data_path(weights).is_file():
             raise UsageError(f"--condition-weights: no such file: {weights}")
         refresh = 0
         if config.mode == "planner":

@@ -34,8 +34,7 @@ from leas_jax.env.config import (
     RewardWeights,
 )
 from leas_jax.errors import UsageError
-
-REPO_ROOT = Path(__file__).resolve().parents[2]
+from leas_jax.files import resolve_data_path
 
 # The reachability condition every preset trains with (TrainConfig's default env): the
 # cylinders alone, trunk r 0.30 m with the root 0.825 m above everything under it, legs
@@ -68,17 +67,6 @@ def learned_condition_env(env: EnvConfig, weights: str = EnvConfig.learned_weigh
 # Planner mode with the learned condition: refit it on the generator's verdicts every this many
 # iterations (`TrainConfig.condition_refresh_every`, see there).
 LEARNED_REFRESH_EVERY = 4
-
-
-def resolve_data_path(path: str | Path) -> Path:
-    """A data file (terrain) as given if it exists, else relative to the repository root.
-
-    Lets `terrains/training_arena.toml` work from any working directory.
-    """
-    path = Path(path)
-    if path.exists() or path.is_absolute():
-        return path
-    return REPO_ROOT / path
 
 
 @dataclass(frozen=True)

@@ -18,8 +18,9 @@ import jax
 import numpy as np
 
 from leas_jax.errors import LeasError, UsageError
+from leas_jax.files import resolve_data_path
 from leas_jax.training import checkpoint, records
-from leas_jax.training.config import TrainConfig, pretraining_config, resolve_data_path
+from leas_jax.training.config import TrainConfig, pretraining_config
 from leas_jax.training.ppo import TrainState, init_state, make_train_call
 
 
@@ -339,11 +340,11 @@ def _pin_condition(run_dir: Path, env) -> None:
     """
     if env.condition != "learned" or (run_dir / RUN_CONDITION).is_file():
         return
-    from leas_jax.env.learned_weights import load_params, resolve_weights
+    from leas_jax.env.learned_weights import load_params
     from leas_jax.feasibility.walking_truth import warn_if_stale
     from leas_jax.files import atomic_write_bytes
 
-    weights = resolve_weights(env.learned_weights)
+    weights = resolve_data_path(env.learned_weights)
     warn_if_stale(weights, load_params(weights)[1])
     run_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(run_dir / RUN_CONDITION, weights.read_bytes())

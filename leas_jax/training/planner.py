@@ -337,7 +337,7 @@ def seed_data(path) -> tuple[np.ndarray, np.ndarray]:
     """Host: the labelled poses of `TrainConfig.condition_seed_data`: (poses [K, 4] float64,
     labels [K] bool). Raises UsageError naming the file and the field when it cannot be used."""
     from leas_jax.errors import UsageError
-    from leas_jax.training.config import resolve_data_path
+    from leas_jax.files import resolve_data_path
 
     where = f"TrainConfig.condition_seed_data: {path}"
     try:

@@ -1,0 +1,86 @@
+"""Settings of motion generation and of its simulation, with units and sources."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class MotionConfig:
+    """How `make_motion` times and shapes a whole-body motion along a contact plan.
+
+    Every key posture of the plan is reached at rest (quasi-static walking, as the
+    plan's postures are static equilibria): the CoM moves only in double support, from one
+    posture's CoM to the next; in single support it stays over the stance sole while the
+    swing foot lifts to the plan's single-support posture and lands on its next placement.
+    """
+
+    # Sampling of the joint trajectory, s (100 Hz).
+    dt: float = 0.01
+    # Single support: lift-off to the plan's single-support posture, then landing, s. The
+    # HPP group's Talos demos use 1.2-1.6 s of single support; 0.6 + 0.8 = 1.4 s, the
+    # landing longer because it carries the foot forward.
+    lift_duration: float = 0.6
+    land_duration: float = 0.8
+    # Double support: at least this long, s (HPP's Talos demos: 0.2-0.5 s, longer when
+    # quasi-static), and long enough that the CoM's peak acceleration along its
+    # minimum-jerk path stays under `com_acceleration`, m/s^2: the zero-moment point then
+    # stays within com_acceleration * h / g = 0.25 * 0.88 / 9.81 = 2.2 cm of the CoM's
+    # projection (h: Talos's CoM height at half-sitting, 0.88 m), a tenth of the sole's width
+    # away from a static stance.
+    min_double_support: float = 0.5
+    com_acceleration: float = 0.25
+    # Swing foot: the landing path's apex is at least this far above the terrain under the
+    # foot's straight path and above both end placements, m (the plan's single-support
+    # postures lift the foot 5-15 cm).
+    swing_clearance: float = 0.05
+    # Sole corners on the swing path may sink this far below the terrain surface, m (the
+    # 5 mm contact tolerance of docs/design.md §6 check 1), except in the first and last
+    # `contact_zone` of height above the contact plane, where the sole leaves or meets it.
+    terrain_tolerance: float = 0.005
+    contact_zone: float = 0.01
+    # Whole-body IK: Newton iterations per sample, damping of the least squares, and the
+    # task error accepted at each sample (m for positions, rad for orientations).
+    ik_iterations: int = 30
+    ik_damping: float = 1e-8
+    ik_tolerance: float = 1e-9
+    # Checks along the motion: equilibrium robustness of hpp-centroidal-dynamics with the
+    # CoM's acceleration (docs/design.md §6 check 4 holds key postures to >= 0), and the
+    # fraction of the URDF's effort and velocity limits a sample may use.
+    min_robustness: float = 0.0
+    torque_ratio: float = 1.0
+    velocity_ratio: float = 1.0
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    """How `simulate` executes a motion in MuJoCo and judges the result.
+
+    Controller: joint torques = inverse-dynamics feed-forward of the motion (Pinocchio's
+    rnea with the contact wrenches the motion plans) + joint PD on the motion's joint
+    positions and velocities, clipped to the URDF's effort limits.
+    """
+
+    # Physics step, s (1 kHz); the controller runs at every step.
+    timestep: float = 0.001
+    # PD gains from each joint's diagonal of the mass matrix at half-sitting (armature
+    # included): kp = M_ii omega^2, kd = 2 zeta M_ii omega, so every joint alone is a
+    # critically damped oscillator of natural frequency `omega`, rad/s (10 Hz; omega * dt =
+    # 0.06, far inside the explicit-PD stability bound of 2).
+    omega: float = 62.8
+    zeta: float = 1.0
+    # Seconds simulated after the motion's last sample (the robot must stay up).
+    settle: float = 0.5
+    # Success: the root (base_link) stays above `min_root_height` over the higher sole in
+    # contact, m (half-sitting puts it 1.02 m above the soles; a fall takes it under 0.5 m),
+    # and tilts at most `max_tilt`, rad (angle between the root z axis and world z).
+    min_root_height: float = 0.6
+    max_tilt: float = 0.5
+    # Each sole lands within `landing_position` (m) and `landing_angle` (rad) of its planned
+    # placement and slips at most `max_slip` while in support, m (the task's bounds).
+    landing_position: float = 0.03
+    landing_angle: float = 0.0873  # 5 deg
+    max_slip: float = 0.01
+    # A sole counts as landed when its box touches the terrain within this time of the
+    # planned touch-down, s; the landing error is read at the end of the landing phase.
+    contact_force: float = 1.0  # N, normal force above which a geom pair counts as touching

@@ -1,0 +1,649 @@
+"""Whole-body motions along contact plans: phases, task references, IK, dynamics and checks.
+
+Host-only (Pinocchio, hpp-centroidal-dynamics), not jittable. `make_motion(plan, config)`
+turns a `ContactPlan` (docs/design.md §6) into a `Motion`: Talos configurations every
+`config.dt` seconds that pass through every key posture of the plan, at rest, in order.
+
+Between consecutive postures k and k+1 (the plan changes at most one foot at a time):
+
+- both feet down in both: one double-support **shift**: the CoM goes from posture k's
+  to posture k+1's along a straight line, the root turns and the upper body moves from
+  one posture's to the other's, all on one minimum-jerk time scaling;
+- k in double support, k+1 on one foot: a **shift** to posture k+1's CoM, root and upper
+  body with both feet still down, then a single-support **lift**: the swing sole leaves
+  its placement along +z and reaches its place in posture k+1 (the plan's lifted foot),
+  the CoM held over the stance sole;
+- k on one foot, k+1 in double support: a single-support **land**: the swing sole
+  rises to an apex above the terrain, travels and comes down along -z onto its new
+  placement, the CoM held; then a **shift** to posture k+1.
+
+The static equilibria of a fixed set of contacts form a convex set of CoM positions, so
+a CoM moving straight between two of them stays in it. Every sample is then checked
+(`check_motion`): joint position and velocity limits, equilibrium robustness with the
+CoM's acceleration (hpp-centroidal-dynamics), joint torques from Pinocchio's rnea within
+the URDF's effort limits.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from leas_jax.contacts.plan import ContactPlan
+from leas_jax.errors import LeasError
+from leas_jax.motion.config import MotionConfig
+
+SIDES = ("left", "right")
+# Key-posture match: the IK's configuration at a key instant must equal the plan's within
+# this (rad and m, Pinocchio's `difference`) before the plan's own is stored there.
+KEY_POSTURE_TOL = 1e-6
+# Keys of a motion file.
+MOTION_KEYS = (
+    "time",
+    "q",
+    "v",
+    "a",
+    "tau",
+    "wrenches",
+    "contact",
+    "feet",
+    "com",
+    "key_index",
+    "phase_kind",
+    "phase_bounds",
+    "phase_postures",
+    "phase_swing",
+    "plan_q",
+    "plan_feet",
+    "terrain",
+    "dt",
+)
+PHASE_KINDS = ("shift", "lift", "land")
+
+
+class MotionError(LeasError):
+    """A motion cannot be made (or read): the message names the phase and why."""
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of a motion.
+
+    Attributes:
+        kind: "shift" (double support, CoM moves), "lift" or "land" (single support).
+        start: sample index where the phase starts (the previous phase's last sample).
+        stop: sample index where it ends, > start.
+        postures: (k, k + 1) plan postures the phase goes between.
+        swing: side in the air (0 left, 1 right), -1 in double support.
+    """
+
+    kind: str
+    start: int
+    stop: int
+    postures: tuple
+    swing: int
+
+    @property
+    def single_support(self) -> bool:
+        return self.swing >= 0
+
+    def describe(self, dt: float) -> str:
+        """One line: kind, postures and time span."""
+        foot = f", {SIDES[self.swing]} foot in the air" if self.swing >= 0 else ""
+        return (
+            f"{self.kind} between postures {self.postures[0]} and {self.postures[1]}{foot} "
+            f"(t = {self.start * dt:.2f}-{self.stop * dt:.2f} s)"
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """A whole-body motion of Talos sampled every `dt` seconds, world frame.
+
+    Attributes:
+        time: [N] s, from 0.
+        q: [N, 39] Pinocchio configurations (root xyz + quaternion xyzw, 32 joints).
+        v: [N, 38] velocities (root linear and angular in the base_link frame, joints).
+        a: [N, 38] accelerations, same frames.
+        tau: [N, 32] joint torques from inverse dynamics, N m, Pinocchio joint order.
+        wrenches: [N, 2, 6] planned (force, torque) at each sole frame, sole frame, N and N m.
+        contact: [N, 2] bool, sole in support (left, right).
+        feet: [N, 2, 7] reference sole placements (xyz + quaternion xyzw), world; the
+            swing sole's moves along its path.
+        com: [N, 3] CoM, world, m.
+        key_index: [K] sample index of each plan posture (q[key_index] == plan.q).
+        phases: tuple of Phase, in time order.
+        plan_q: [K, 39], plan_feet: [K, 2, 7]: the plan's postures and placements.
+        terrain: the terrain file's text.
+        dt: sampling period, s.
+    """
+
+    time: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    wrenches: np.ndarray
+    contact: np.ndarray
+    feet: np.ndarray
+    com: np.ndarray
+    key_index: np.ndarray
+    phases: tuple
+    plan_q: np.ndarray
+    plan_feet: np.ndarray
+    terrain: str
+    dt: float
+    failures: list = field(default_factory=list)
+
+    @property
+    def duration(self) -> float:
+        """Length of the motion, s."""
+        return float(self.time[-1])
+
+    def phase_at(self, sample: int) -> int:
+        """Index of the phase holding sample index `sample` (phases own (start, stop])."""
+        for index, phase in enumerate(self.phases):
+            if sample <= phase.stop:
+                return index
+        return len(self.phases) - 1
+
+    def save(self, path) -> None:
+        """Write the motion as an .npz with the keys of MOTION_KEYS, atomically."""
+        from leas_jax.files import atomic_write_bytes
+
+        buffer = io.BytesIO()
+        np.savez(
+            buffer,
+            time=self.time,
+            q=self.q,
+            v=self.v,
+            a=self.a,
+            tau=self.tau,
+            wrenches=self.wrenches,
+            contact=self.contact,
+            feet=self.feet,
+            com=self.com,
+            key_index=self.key_index,
+            phase_kind=np.array([PHASE_KINDS.index(p.kind) for p in self.phases], dtype=np.int64),
+            phase_bounds=np.array([(p.start, p.stop) for p in self.phases], dtype=np.int64).reshape(-1, 2),
+            phase_postures=np.array([p.postures for p in self.phases], dtype=np.int64).reshape(-1, 2),
+            phase_swing=np.array([p.swing for p in self.phases], dtype=np.int64),
+            plan_q=self.plan_q,
+            plan_feet=self.plan_feet,
+            terrain=np.str_(self.terrain),
+            dt=np.float64(self.dt),
+        )
+        atomic_write_bytes(os.fspath(path), buffer.getvalue())
+
+    @classmethod
+    def load(cls, path) -> Motion:
+        """Read a motion written by `save`.
+
+        Raises:
+            MotionError: not a motion file, a key missing or arrays of the wrong shape.
+        """
+        import zipfile
+
+        try:
+            data = np.load(path, allow_pickle=False)
+        except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
+            raise MotionError(f"{path}: not a readable motion file ({type(exc).__name__}: {exc})") from None
+        with data:
+            if not isinstance(data, np.lib.npyio.NpzFile):
+                raise MotionError(f"{path}: a single .npy array, expected a motion .npz")
+            missing = [key for key in MOTION_KEYS if key not in data.files]
+            if missing:
+                raise MotionError(f"{path}: missing key '{missing[0]}' (not a motion file?)")
+            arrays = {key: data[key] for key in MOTION_KEYS}
+        n = len(arrays["time"])
+        shapes = {
+            "q": (n, 39),
+            "v": (n, 38),
+            "a": (n, 38),
+            "tau": (n, 32),
+            "wrenches": (n, 2, 6),
+            "contact": (n, 2),
+            "feet": (n, 2, 7),
+            "com": (n, 3),
+        }
+        for key, shape in shapes.items():
+            if arrays[key].shape != shape:
+                raise MotionError(
+                    f"{path}: key '{key}' has shape {list(arrays[key].shape)}, expected {list(shape)}"
+                )
+        if n < 2 or not np.isfinite(arrays["q"]).all():
+            raise MotionError(f"{path}: key 'q' must hold at least 2 finite configurations")
+        phases = tuple(
+            Phase(
+                PHASE_KINDS[int(kind)],
+                int(bounds[0]),
+                int(bounds[1]),
+                tuple(int(p) for p in postures),
+                int(swing),
+            )
+            for kind, bounds, postures, swing in zip(
+                arrays["phase_kind"], arrays["phase_bounds"], arrays["phase_postures"], arrays["phase_swing"]
+            )
+        )
+        return cls(
+            time=arrays["time"],
+            q=arrays["q"],
+            v=arrays["v"],
+            a=arrays["a"],
+            tau=arrays["tau"],
+            wrenches=arrays["wrenches"],
+            contact=arrays["contact"].astype(bool),
+            feet=arrays["feet"],
+            com=arrays["com"],
+            key_index=arrays["key_index"],
+            phases=phases,
+            plan_q=arrays["plan_q"],
+            plan_feet=arrays["plan_feet"],
+            terrain=str(arrays["terrain"]),
+            dt=float(arrays["dt"]),
+        )
+
+
+@dataclass(frozen=True)
+class _PhaseSpec:
+    """A phase's task references at its two ends (world frame) before sampling.
+
+    Attributes:
+        kind, postures, swing: as in Phase.
+        samples: number of samples (duration / dt).
+        feet0, feet1: [2, 4, 4] sole placements at the start and end.
+        com0, com1: [3] CoM at the start and end.
+        rot0, rot1: [3, 3] root orientation at the start and end.
+        upper0, upper1: [39] configurations whose upper-body joints are used.
+        control: [P, 3] Bezier control points of the swing sole's path (empty in a shift).
+    """
+
+    kind: str
+    postures: tuple
+    swing: int
+    samples: int
+    feet0: np.ndarray
+    feet1: np.ndarray
+    com0: np.ndarray
+    com1: np.ndarray
+    rot0: np.ndarray
+    rot1: np.ndarray
+    upper0: np.ndarray
+    upper1: np.ndarray
+    control: np.ndarray
+
+
+def _homogeneous(placement: np.ndarray) -> np.ndarray:
+    """[4, 4] of a placement [7] (xyz + quaternion xyzw)."""
+    from leas_jax.contacts.robot.model import matrix_from_quat_xyzw
+
+    out = np.eye(4)
+    out[:3, :3] = matrix_from_quat_xyzw(placement[3:])
+    out[:3, 3] = placement[:3]
+    return out
+
+
+def _placement(homogeneous: np.ndarray) -> np.ndarray:
+    """[7] xyz + quaternion xyzw of a [4, 4] placement."""
+    from leas_jax.contacts.robot.model import quat_xyzw_from_matrix
+
+    return np.r_[homogeneous[:3, 3], quat_xyzw_from_matrix(homogeneous[:3, :3])]
+
+
+def posture_frames(talos, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sole placements [2, 4, 4], CoM [3] and root rotation [3, 3] of a configuration q [39]."""
+    import pinocchio as pin
+
+    data = talos.model.createData()
+    pin.framesForwardKinematics(talos.model, data, q)
+    feet = np.array([data.oMf[f].homogeneous for f in talos.sole_frame_ids])
+    com = np.array(pin.centerOfMass(talos.model, data, q, False))
+    return feet, com, np.array(data.oMi[1].rotation)
+
+
+def _contacts(plan: ContactPlan, k: int) -> np.ndarray:
+    """[2] bool: soles in contact at plan posture k."""
+    return ~np.isnan(plan.feet[k, :, 0])
+
+
+def _apex(terrain, start: np.ndarray, end: np.ndarray, clearance: float) -> float:
+    """Height of a landing path's apex: `clearance` m above both ends and the terrain between.
+
+    The terrain is sampled under the sole rectangle (its corners and centre) at 21 points
+    along the straight segment from start [3] to end [3], world.
+    """
+    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
+
+    reach = np.hypot(SOLE_LENGTH, SOLE_WIDTH) / 2
+    line = np.linspace(start[:2], end[:2], 21)
+    offsets = np.array([[0.0, 0.0], [reach, 0.0], [-reach, 0.0], [0.0, reach], [0.0, -reach]])
+    heights = terrain.height_at((line[:, None, :] + offsets[None]).reshape(-1, 2))
+    return float(max(start[2], end[2], heights.max()) + clearance)
+
+
+def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig) -> list[_PhaseSpec]:
+    """Phases from plan posture k to k + 1.
+
+    Args:
+        frames: list over postures of (feet [2, 4, 4], com [3], root rotation [3, 3]) by FK.
+
+    Raises:
+        MotionError: the two postures differ in a way no phase sequence handles (both
+            feet change, a foot moves while in contact, two single supports in a row).
+    """
+    from leas_jax.motion.paths import landing_path, lift_path, shift_duration
+
+    feet_a, com_a, rot_a = frames[k]
+    feet_b, com_b, rot_b = frames[k + 1]
+    on_a, on_b = _contacts(plan, k), _contacts(plan, k + 1)
+    q_a, q_b = plan.q[k], plan.q[k + 1]
+    dt = config.dt
+
+    def shift(feet, com0, com1, rot0, rot1, upper0, upper1):
+        seconds = shift_duration(
+            float(np.linalg.norm(com1 - com0)), config.com_acceleration, config.min_double_support, dt
+        )
+        return _PhaseSpec(
+            "shift", (k, k + 1), -1, round(seconds / dt), feet, feet, com0, com1, rot0, rot1, upper0, upper1,
+            np.zeros((0, 3)),
+        )  # fmt: skip
+
+    if on_a.all() and on_b.all():
+        for side in (0, 1):
+            if not np.allclose(feet_a[side], feet_b[side], atol=1e-6):
+                raise MotionError(
+                    f"postures {k} and {k + 1}: the {SIDES[side]} sole moves while both are in contact"
+                )
+        return [shift(feet_a, com_a, com_b, rot_a, rot_b, q_a, q_b)]
+    if on_a.all() and on_b.sum() == 1:
+        swing = int(np.flatnonzero(~on_b)[0])
+        lifted = feet_a.copy()
+        lifted[swing] = feet_b[swing]
+        control = lift_path(feet_a[swing][:3, 3], feet_b[swing][:3, 3])
+        return [
+            shift(feet_a, com_a, com_b, rot_a, rot_b, q_a, q_b),
+            _PhaseSpec(
+                "lift", (k, k + 1), swing, round(config.lift_duration / dt), feet_a, lifted, com_b, com_b,
+                rot_b, rot_b, q_b, q_b, control,
+            ),
+        ]  # fmt: skip
+    if on_a.sum() == 1 and on_b.all():
+        swing = int(np.flatnonzero(~on_a)[0])
+        stance = 1 - swing
+        if not np.allclose(feet_a[stance], feet_b[stance], atol=1e-6):
+            raise MotionError(f"postures {k} and {k + 1}: the {SIDES[stance]} (stance) sole moves")
+        apex = _apex(terrain, feet_a[swing][:3, 3], feet_b[swing][:3, 3], config.swing_clearance)
+        control = landing_path(feet_a[swing][:3, 3], feet_b[swing][:3, 3], apex)
+        landed = feet_a.copy()
+        landed[swing] = feet_b[swing]
+        return [
+            _PhaseSpec(
+                "land", (k, k + 1), swing, round(config.land_duration / dt), feet_a, landed, com_a, com_a,
+                rot_a, rot_a, q_a, q_a, control,
+            ),
+            shift(feet_b, com_a, com_b, rot_a, rot_b, q_a, q_b),
+        ]  # fmt: skip
+    raise MotionError(
+        f"postures {k} and {k + 1}: contacts {on_a.astype(int).tolist()} -> {on_b.astype(int).tolist()} "
+        "(a motion goes from double support to one foot or back)"
+    )
+
+
+def phase_references(spec: _PhaseSpec, dt: float):
+    """Task references of a phase's samples 1..n (sample 0 is the previous phase's end).
+
+    Returns:
+        list of n (wbik.Targets, feet placements [2, 4, 4]).
+    """
+    from leas_jax.motion.paths import bezier, lerp, min_jerk, slerp
+    from leas_jax.motion.wbik import Targets
+
+    fractions = np.arange(1, spec.samples + 1) / spec.samples
+    s = min_jerk(fractions)
+    coms = lerp(spec.com0, spec.com1, s)
+    rots = slerp(spec.rot0, spec.rot1, s)
+    uppers = lerp(spec.upper0, spec.upper1, s)
+    feet = np.repeat(spec.feet0[None], spec.samples, axis=0)
+    if spec.swing >= 0:
+        positions = bezier(spec.control, s)
+        turns = slerp(spec.feet0[spec.swing][:3, :3], spec.feet1[spec.swing][:3, :3], s)
+        feet[:, spec.swing, :3, :3] = turns
+        feet[:, spec.swing, :3, 3] = positions
+        feet[-1, spec.swing] = spec.feet1[spec.swing]
+    return [Targets(feet[i], coms[i], rots[i], uppers[i]) for i in range(spec.samples)]
+
+
+def _swing_clearance(terrain, spec: _PhaseSpec, references, config: MotionConfig) -> str | None:
+    """Why a phase's swing sole meets the terrain, or None.
+
+    A sole corner may sink `terrain_tolerance` below the surface under it, except within
+    `contact_zone` of height above its placement at lift-off or landing.
+    """
+    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
+
+    if spec.swing < 0:
+        return None
+    corners = np.array(
+        [[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0] for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+    )
+    contact_z = spec.feet0[spec.swing][2, 3] if spec.kind == "lift" else spec.feet1[spec.swing][2, 3]
+    for i, ref in enumerate(references):
+        sole = ref.feet[spec.swing]
+        if sole[2, 3] - contact_z < config.contact_zone:
+            continue
+        world = sole[:3, 3] + corners @ sole[:3, :3].T
+        gaps = world[:, 2] - terrain.height_at(world[:, :2])
+        if gaps.min() < -config.terrain_tolerance:
+            return (
+                f"the swing sole's corner is {-gaps.min() * 100:.1f} cm inside the terrain at sample {i + 1}"
+            )
+    return None
+
+
+def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check: bool = True) -> Motion:
+    """A whole-body motion through every key posture of `plan`, at rest at each.
+
+    Args:
+        plan: the contact plan (at least 2 postures).
+        config: timing, paths, IK and check settings.
+        check: raise MotionError on the first sample that fails `check_motion`.
+
+    Returns:
+        Motion sampled every config.dt seconds; motion.failures lists the checks' failures
+        (empty when check is True).
+
+    Raises:
+        MotionError: a phase cannot be made (the message names it and says why).
+    """
+    from leas_jax.contacts.robot.model import load_talos
+    from leas_jax.motion.wbik import IKError, WholeBodyIK
+    from leas_jax.terrain import loads_terrain
+
+    if len(plan) < 2:
+        raise MotionError(f"the plan has {len(plan)} posture(s); a motion needs at least 2")
+    talos = load_talos()
+    terrain = loads_terrain(plan.terrain, source="<plan terrain>")
+    frames = [posture_frames(talos, q) for q in plan.q]
+    specs = []
+    for k in range(len(plan) - 1):
+        specs.extend(_segment_phases(plan, k, frames, terrain, config))
+    ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
+    q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
+    contact_samples.append(_contacts(plan, 0))
+    phases, key_index = [], [0]
+    for spec in specs:
+        start = len(q_samples) - 1
+        phase = Phase(spec.kind, start, start + spec.samples, spec.postures, spec.swing)
+        references = phase_references(spec, config.dt)
+        reason = _swing_clearance(terrain, spec, references, config)
+        if reason:
+            raise MotionError(f"{phase.describe(config.dt)}: {reason}")
+        in_contact = np.array([side != spec.swing for side in (0, 1)])
+        q = q_samples[-1]
+        for i, ref in enumerate(references):
+            try:
+                q = ik.solve(q, ref)
+            except IKError as exc:
+                raise MotionError(f"{phase.describe(config.dt)}: sample {i + 1}: {exc}") from None
+            q_samples.append(q)
+            feet_samples.append(ref.feet)
+            com_samples.append(ref.com)
+            contact_samples.append(in_contact)
+        last = spec.postures[1]
+        if _ends_segment(specs, spec):
+            gap = _configuration_gap(talos.model, q_samples[-1], plan.q[last])
+            if gap > KEY_POSTURE_TOL:
+                raise MotionError(
+                    f"{phase.describe(config.dt)}: the IK ends {gap:.1e} from posture {last} (another IK branch)"
+                )
+            q_samples[-1] = plan.q[last].copy()
+            contact_samples[-1] = _contacts(plan, last)
+            key_index.append(len(q_samples) - 1)
+        phases.append(phase)
+    q = np.array(q_samples)
+    contact = np.array(contact_samples)
+    v, a = _derivatives(talos.model, q, config.dt)
+    tau, wrenches = _torques(talos, q, v, a, contact)
+    feet = np.array([[_placement(f) for f in pair] for pair in feet_samples])
+    motion = Motion(
+        time=np.arange(len(q)) * config.dt,
+        q=q,
+        v=v,
+        a=a,
+        tau=tau,
+        wrenches=wrenches,
+        contact=contact,
+        feet=feet,
+        com=np.array(com_samples),
+        key_index=np.array(key_index),
+        phases=tuple(phases),
+        plan_q=np.array(plan.q),
+        plan_feet=np.array(plan.feet),
+        terrain=plan.terrain,
+        dt=config.dt,
+    )
+    failures = check_motion(motion, config)
+    if check and failures:
+        sample, index, name, message = failures[0]
+        raise MotionError(
+            f"{motion.phases[index].describe(config.dt)}: {name} fails at t = {sample * config.dt:.2f} s: {message}"
+            f" ({len(failures)} failing samples)"
+        )
+    motion.failures.extend(failures)
+    return motion
+
+
+def _ends_segment(specs: list, spec: _PhaseSpec) -> bool:
+    """Whether `spec` is the last phase between its two postures (its end is a key instant)."""
+    same = [s for s in specs if s.postures == spec.postures]
+    return same[-1] is spec
+
+
+def _configuration_gap(model, q0: np.ndarray, q1: np.ndarray) -> float:
+    """Largest coordinate of Pinocchio's `difference(q0, q1)` (m and rad)."""
+    import pinocchio as pin
+
+    return float(np.abs(pin.difference(model, q0, q1)).max())
+
+
+def _derivatives(model, q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations [N, 38] of configurations q [N, 39] by central differences.
+
+    The first and last samples are at rest (zero velocity and acceleration).
+    """
+    import pinocchio as pin
+
+    steps = np.array([pin.difference(model, q[i], q[i + 1]) for i in range(len(q) - 1)]) / dt  # [N-1]
+    v = np.zeros((len(q), model.nv))
+    a = np.zeros((len(q), model.nv))
+    v[1:-1] = 0.5 * (steps[:-1] + steps[1:])
+    a[1:-1] = (steps[1:] - steps[:-1]) / dt
+    return v, a
+
+
+def _torques(talos, q, v, a, contact) -> tuple[np.ndarray, np.ndarray]:
+    """Joint torques [N, 32] and sole wrenches [N, 2, 6] of the motion (dynamics.contact_torques)."""
+    from leas_jax.motion.dynamics import contact_torques
+
+    data = talos.model.createData()
+    tau = np.empty((len(q), 32))
+    wrenches = np.empty((len(q), 2, 6))
+    for i in range(len(q)):
+        tau[i], wrenches[i], _ = contact_torques(
+            talos.model, data, q[i], v[i], a[i], talos.sole_frame_ids, contact[i], talos.mass
+        )
+    return tau, wrenches
+
+
+def check_motion(motion: Motion, config: MotionConfig = MotionConfig()) -> list[tuple[int, int, str, str]]:
+    """Samples of a motion that fail a check.
+
+    Checks at every sample: joint positions within the URDF's limits; joint velocities
+    within `velocity_ratio` of the URDF's; static equilibrium with the CoM's acceleration
+    (hpp-centroidal-dynamics robustness >= `min_robustness` over the sole corners in
+    contact); joint torques within `torque_ratio` of the effort limits; the stored torques
+    equal to a fresh inverse dynamics of (q, v, a) (so edited torques are caught too).
+
+    Returns:
+        list of (sample index, phase index, check name, message), in time order per check.
+    """
+    from leas_jax.contacts.robot.equilibrium import HppEquilibrium
+    from leas_jax.contacts.robot.model import load_talos
+
+    talos = load_talos()
+    model = talos.model
+    lower, upper = model.lowerPositionLimit[7:], model.upperPositionLimit[7:]
+    speed = model.velocityLimit[6:] * config.velocity_ratio
+    effort = model.effortLimit[6:] * config.torque_ratio
+    failures = []
+
+    def fail(sample, name, message):
+        failures.append((int(sample), motion.phase_at(int(sample)), name, message))
+
+    joints = [model.names[j] for j in range(2, model.njoints)]
+    over = (motion.q[:, 7:] < lower - 1e-9) | (motion.q[:, 7:] > upper + 1e-9)
+    for sample, joint in zip(*np.nonzero(over)):
+        fail(sample, "joint limits", f"{joints[joint]} = {motion.q[sample, 7 + joint]:.3f} rad")
+    fast = np.abs(motion.v[:, 6:]) > speed
+    for sample, joint in zip(*np.nonzero(fast)):
+        fail(sample, "velocity limits", f"{joints[joint]} at {motion.v[sample, 6 + joint]:.2f} rad/s")
+    ratio = np.abs(motion.tau) / effort
+    for sample, joint in zip(*np.nonzero(ratio > 1.0)):
+        fail(
+            sample,
+            "torque limits",
+            f"{joints[joint]} needs {motion.tau[sample, joint]:.1f} N m ({ratio[sample, joint]:.2f} x its limit)",
+        )
+    fresh, _ = _torques(talos, motion.q, motion.v, motion.a, motion.contact)
+    wrong = np.abs(fresh - motion.tau).max(axis=1) > 1e-6 * (1.0 + np.abs(fresh).max(axis=1))
+    for sample in np.flatnonzero(wrong):
+        fail(sample, "inverse dynamics", "the stored torques differ from rnea's")
+    solver = HppEquilibrium(talos.mass)
+    acceleration = np.zeros_like(motion.com)
+    acceleration[1:-1] = (motion.com[2:] - 2 * motion.com[1:-1] + motion.com[:-2]) / motion.dt**2
+    for sample in range(len(motion.q)):
+        feet = np.where(motion.contact[sample][:, None], motion.feet[sample], np.nan)
+        value = _robustness(solver, feet, motion.com[sample], acceleration[sample])
+        if not value >= config.min_robustness:
+            fail(sample, "equilibrium", f"robustness {value:.3g} < {config.min_robustness}")
+    failures.sort(key=lambda item: item[0])
+    return failures
+
+
+def _robustness(solver, feet: np.ndarray, com: np.ndarray, acceleration: np.ndarray) -> float:
+    """hpp-centroidal-dynamics robustness of feet [2, 7] (NaN rows in the air) at a CoM [3] accelerating [3]."""
+    from leas_jax.contacts.robot.equilibrium import sole_corners
+
+    points, normals = sole_corners(feet)
+    if len(points) == 0:
+        return -np.inf
+    solver.set_contacts(points, normals)
+    status, value = solver._eq.computeEquilibriumRobustness(
+        np.asarray(com, dtype=np.float64), np.asarray(acceleration, dtype=np.float64)
+    )
+    if status != solver._hpp.LP_status.LP_STATUS_OPTIMAL:
+        return -np.inf
+    return float(value)

@@ -4,19 +4,39 @@ The lattice covers the terrain's bounds with cells of `resolution` m and 16 head
 directions of the 16-neighbourhood offsets (1, 0), (2, 1), (1, 1), (1, 2), ... (every 22.5 deg
 on average; an offset, not an angle, so that a forward move lands on a cell centre). Each node
 (cell, heading) is the root pose (x, y, z = terrain + nominal height, yaw = heading), and each
-forward move (cell -> cell + offset, same heading) is checked at its midpoint as well. Both are
-judged by `steering.baselines.lift_checked`, the reachability condition of the LeaS environment
-plus solid ground under the root: the same test as the RBKino+RRT baseline's, so the two global
-layers search the same valid set. The check runs as vmapped jitted calls over fixed-size chunks
-of poses (one compiled shape for every terrain, memory bounded by the chunk).
+forward move (cell -> cell + offset, same heading) is checked at its midpoint as well.
+
+Nodes are judged twice (a condition plus solid ground under the root, as the RBKino+RRT
+baseline's `steering.baselines.lift_checked`):
+  - *confident*: the reachability condition of the LeaS environment, the one fitted on flat
+    ground, stairs and holes of the training arena;
+  - *plausible*: the same cylinders with the checks that rough ground fails for no kinematic
+    reason relaxed (`relaxed_reachability`): a tilted tile or a block's edge fails the
+    confident condition's sole-flatness test, and its lookahead legs refuse a step down that
+    the legs reach from a lowered root. Plausible nodes keep the trunk, leg-reach, hands and
+    no-void tests, which no contact plan passes without.
+A node that is plausible but not confident is *doubtful*: the search offers it at a cost
+(`SearchConfig.doubt_penalty`), and the contact generator, which judges every guide, decides
+(validation on demand, as lazy PRM and lazy A* validate edges only on the path they find).
+A step model bounds each forward move: the root's height changes by at most `max_step`
+between the move's ends and its midpoint, up or down (a riser that the legs do not reach in
+one step is not an edge). The check runs as vmapped jitted calls over fixed-size chunks of
+poses (one compiled shape for every terrain, memory bounded by the chunk).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
+import jax
+import jax.numpy as jnp
 import numpy as np
+
+from leas_jax.env import reachability
+from leas_jax.env.field import sample_nearest
 
 # The 16-neighbourhood offsets (cells), counter-clockwise from +x: the lattice's headings.
 OFFSETS = np.array(
@@ -41,6 +61,25 @@ class LatticeConfig:
     resolution: float = 0.05  # m
     chunk: int = 1 << 16  # poses per jitted call (one compiled shape)
     max_cells: int = 400_000  # refuse larger lattices (memory ~ 100 B per node); coarsen instead
+    # Offer doubtful nodes (plausible, not confident) to the search; False keeps the confident
+    # set alone (the lattice of earlier versions).
+    offer_doubtful: bool = True
+    # m, plausible nodes' sole-flatness bound (a sole disk within foothold_search of each leg whose
+    # heights span at most this; the confident condition: 0.04 m), or None: no such term. None:
+    # a root over a crack between rubble tiles or a missing tile has no flat sole disk within
+    # the condition's 0.10 m search of its legs, yet the generator places the feet a stride
+    # before and after it; the leg disks must still touch solid ground.
+    relaxed_foothold_spread: float | None = None
+    # m, the step model: the root's height changes by at most this between a move's end and its
+    # midpoint, up or down. At the nominal root height the leg band (sole 0.75-1.175 m below the
+    # root) holds a tread 0.25 m above or 0.175 m below the one under the root; a lowered root
+    # reaches further down, so one bound both ways.
+    max_step: float = 0.25
+    # m: a strip of void narrower than this under the root (a crack between rubble tiles) counts
+    # as ground: the root stands at the height of the ground beside it and the generator steps
+    # over the strip. The edge of a platform stays an edge (a morphological closing of the
+    # solid ground, which fills strips bounded on both sides only).
+    crack_width: float = 0.10
 
 
 @dataclass(frozen=True)
@@ -50,11 +89,16 @@ class Lattice:
     Attributes:
         origin: [2] world (x, y) of cell (0, 0), m.
         resolution: m between cell centres.
-        node_valid: [nx, ny, 16] bool, the pose at cell (i, j), heading h is valid.
+        node_valid: [nx, ny, 16] bool, the pose at cell (i, j), heading h is valid: confident,
+            or plausible where the config offers doubtful nodes.
         move_valid: [nx, ny, 16] bool, the forward move from (i, j, h) to
-            (i, j) + OFFSETS[h] (same heading) is valid: both ends and the midpoint.
+            (i, j) + OFFSETS[h] (same heading) is valid: both ends and the midpoint valid,
+            the root's height within `max_step` between them.
         clearance: [nx, ny, 16] float, m from the node to the nearest invalid node of the
             same heading (0 for invalid nodes).
+        doubtful: [nx, ny, 16] bool, valid nodes that only the relaxed condition accepts.
+        move_doubtful: [nx, ny, 16] bool, valid moves whose midpoint or end is doubtful.
+        root_height: [nx, ny] float, root z (m, world) at each cell centre: terrain + nominal.
     """
 
     origin: np.ndarray
@@ -62,6 +106,9 @@ class Lattice:
     node_valid: np.ndarray
     move_valid: np.ndarray
     clearance: np.ndarray
+    doubtful: np.ndarray
+    move_doubtful: np.ndarray
+    root_height: np.ndarray
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -88,17 +135,85 @@ def heading_index(yaw) -> np.ndarray:
     return np.argmin(np.abs(diff), axis=-1)
 
 
-def _check(field, planar: np.ndarray, nominal_root_height: float, reach, chunk: int) -> np.ndarray:
-    """lift_checked's validity of planar poses [M, 3] (x, y, yaw), `chunk` poses per jitted call."""
-    from leas_jax.steering.baselines import lift_checked
+def relaxed_reachability(reach, config: LatticeConfig):
+    """The plausible nodes' condition: `reach` (a `ReachabilityConfig`) without its lookahead
+    legs (the step model bounds height changes instead) and, unless
+    `config.relaxed_foothold_spread` is set, without its sole-flatness term (the leg disks must
+    still touch solid ground)."""
+    spread = reach.foothold_spread
+    if spread is not None:
+        spread = (
+            None if config.relaxed_foothold_spread is None else max(spread, config.relaxed_foothold_spread)
+        )
+    return dataclasses.replace(reach, leg_forward=0.0, foothold_spread=spread)
 
-    out = np.zeros(len(planar), bool)
+
+def _all_terms(field, pose: jax.Array, reach) -> jax.Array:
+    """`reachability.valid` as a chain of ands: the disabled terms' constant True fold away
+    (stacked, XLA spends seconds constant-folding them over a 65 536-pose chunk)."""
+    return functools.reduce(jnp.logical_and, reachability.terms(field, pose, reach).values())
+
+
+def crack_filled_ground(field, crack_width: float) -> np.ndarray:
+    """[nx, ny] bool over the field's grid: solid ground, or void narrower than `crack_width`
+    (m) between solid ground on both sides (host; a binary closing by a disk)."""
+    from scipy import ndimage
+
+    heights = np.asarray(field.heights)
+    solid = heights > float(field.void_height) + 1e-3
+    radius = int(round(0.5 * crack_width / float(field.resolution)))
+    if radius < 1:
+        return solid
+    di, dj = np.meshgrid(np.arange(-radius, radius + 1), np.arange(-radius, radius + 1), indexing="ij")
+    disk = di**2 + dj**2 <= radius**2
+    padded = np.pad(solid, radius, mode="edge")  # the grid's border is no edge of the ground
+    return solid | ndimage.binary_closing(padded, structure=disk)[radius:-radius, radius:-radius]
+
+
+@functools.partial(jax.jit, static_argnums=(3, 4, 5))
+def _judge(field, ground_ok: jax.Array, planar: jax.Array, nominal_root_height: float, confident, plausible):
+    """Root z and both verdicts of planar poses [M, 3] (x, y, yaw) -> (z [M], confident [M],
+    plausible [M]).
+
+    The root stands `nominal_root_height` above the highest solid ground within `leg_radius`
+    of it (`Heightfield.leg_max`), not above the point under it: a root over a crack between
+    rubble tiles stands at the tiles' height, where the generator's feet are. The ground under
+    it must be solid or a crack (`ground_ok` [nx, ny] bool, `crack_filled_ground`).
+    """
+    ground = sample_nearest(field, field.leg_max, planar[:, :2], outside=-jnp.inf)
+    solid = jnp.isfinite(ground) & sample_nearest(field, ground_ok, planar[:, :2], outside=False)
+    z = jnp.where(solid, ground, field.void_height) + nominal_root_height
+    poses = jnp.stack([planar[:, 0], planar[:, 1], z, planar[:, 2]], axis=1)
+    sure = jax.vmap(lambda pose: _all_terms(field, pose, confident))(poses) & solid
+    maybe = jax.vmap(lambda pose: _all_terms(field, pose, plausible))(poses) & solid
+    return z, sure, maybe
+
+
+def _check(
+    field, ground_ok, planar: np.ndarray, nominal_root_height: float, confident, plausible, chunk: int
+):
+    """`_judge` over planar poses [M, 3] (x, y, yaw), `chunk` poses per jitted call (one
+    compiled shape). -> (root z [M] float, confident [M] bool, plausible [M] bool)."""
+    out = np.zeros((3, len(planar)))
     for begin in range(0, len(planar), chunk):
         part = planar[begin : begin + chunk]
         if len(part) < chunk:  # pad: every call has the same shape (one compile)
             part = np.concatenate([part, np.repeat(part[-1:], chunk - len(part), axis=0)])
-        _, ok = lift_checked(field, part, nominal_root_height, reach)
-        out[begin : begin + chunk] = ok[: min(chunk, len(planar) - begin)]
+        n = min(chunk, len(planar) - begin)
+        judged = _judge(field, ground_ok, jnp.asarray(part), float(nominal_root_height), confident, plausible)
+        out[:, begin : begin + n] = np.stack([np.asarray(a, np.float64)[:n] for a in judged])
+    return out[0], out[1] > 0.5, out[2] > 0.5
+
+
+def _shifted(grid: np.ndarray, dx: int, dy: int, fill) -> np.ndarray:
+    """grid[i + dx, j + dy, ...] at each (i, j) of grid [nx, ny, ...], `fill` off the grid."""
+    nx, ny = grid.shape[:2]
+    out = np.full_like(grid, fill)
+    xs = slice(max(dx, 0), nx + min(dx, 0))
+    ys = slice(max(dy, 0), ny + min(dy, 0))
+    xd = slice(max(-dx, 0), nx + min(-dx, 0))
+    yd = slice(max(-dy, 0), ny + min(-dy, 0))
+    out[xd, yd] = grid[xs, ys]
     return out
 
 
@@ -141,19 +256,25 @@ def build_lattice(
             np.column_stack([middles.reshape(-1, 2), yaw.reshape(-1)]),
         ]
     ).astype(np.float32)
-    ok = _check(field, planar, nominal_root_height, reach, config.chunk)
-    node_valid = ok[: nx * ny * 16].reshape(nx, ny, 16)
-    middle_valid = ok[nx * ny * 16 :].reshape(nx, ny, 16)
-    move_valid = node_valid & middle_valid
+    plausible = relaxed_reachability(reach, config) if config.offer_doubtful else reach
+    ground_ok = jnp.asarray(crack_filled_ground(field, config.crack_width))
+    z, confident, ok = _check(field, ground_ok, planar, nominal_root_height, reach, plausible, config.chunk)
+    ok |= confident
+    count = nx * ny * 16
+    node_valid = ok[:count].reshape(nx, ny, 16)
+    doubtful = node_valid & ~confident[:count].reshape(nx, ny, 16)
+    root_height = z[:count].reshape(nx, ny, 16)[:, :, 0]
+    middle_z = z[count:].reshape(nx, ny, 16)
+    move_valid = node_valid & ok[count:].reshape(nx, ny, 16)
+    move_doubtful = ~confident[count:].reshape(nx, ny, 16)  # the midpoint's
     for h, (dx, dy) in enumerate(OFFSETS):
-        target = np.zeros((nx, ny), bool)  # node_valid of (i + dx, j + dy, h), False off the grid
-        xs = slice(max(dx, 0), nx + min(dx, 0))
-        ys = slice(max(dy, 0), ny + min(dy, 0))
-        xd = slice(max(-dx, 0), nx + min(-dx, 0))
-        yd = slice(max(-dy, 0), ny + min(-dy, 0))
-        target[xd, yd] = node_valid[xs, ys, h]
-        move_valid[:, :, h] &= target
+        target_z = _shifted(root_height, int(dx), int(dy), np.nan)  # NaN off the grid: no move
+        target_ok = _shifted(node_valid[:, :, h], int(dx), int(dy), False)
+        step = np.maximum(np.abs(middle_z[:, :, h] - root_height), np.abs(target_z - middle_z[:, :, h]))
+        move_valid[:, :, h] &= target_ok & (np.nan_to_num(step, nan=np.inf) <= config.max_step)
+        move_doubtful[:, :, h] |= _shifted(doubtful[:, :, h], int(dx), int(dy), False)
+    move_doubtful &= move_valid
     clearance = np.stack(
         [ndimage.distance_transform_edt(node_valid[:, :, h]) * res for h in range(16)], axis=-1
     )
-    return Lattice(origin, res, node_valid, move_valid, clearance)
+    return Lattice(origin, res, node_valid, move_valid, clearance, doubtful, move_doubtful, root_height)

@@ -12,6 +12,12 @@ One query runs, in a closed loop with the contact generator:
    and the search is repeated from a verified pose `backoff_distance` before its last valid
    posture, at most `max_replans` times.
 
+The lattice offers doubtful ground (plausible, not confident: `lattice`) at a cost; the
+generator's verdicts are what the loop learns from, kept across the replans of a query: the
+cells its verified postures stand on are trusted (doubtful moves into them cost nothing
+extra), the disks where it failed are penalised. Doubtful ground is thus validated on demand,
+as a lazy planner validates only the edges of the paths it finds.
+
 The generator plans each grown guide from its start, so the returned plan is one continuous
 plan that `leas verify` checks like any other. Nothing in the loop is random: a query's
 answer is a function of the policy, the terrain, the query and the configs, whatever the
@@ -60,6 +66,9 @@ class NavigateConfig:
     horizon_factor: float = 2.5
     horizon_quantum: int = 200
     via_radius: float = 0.5  # m: a route point counts as passed once the guide came this close
+    # m: cells this close to a verified guide pose are trusted (a doubtful move into them costs
+    # nothing extra); about the half-width of the feet's stance (0.085 m each side) plus a cell
+    trust_radius: float = 0.15
     generator: object = None  # `GeneratorConfig` of the contact generator (None: its defaults)
 
 
@@ -88,6 +97,7 @@ class _State:
 
     query: Query
     penalty: np.ndarray
+    trusted: np.ndarray  # [nx, ny] bool, cells the generator's verified postures stood on
     guide: np.ndarray | None = None
     segment_begin: int = 0
     search: SearchResult | None = None
@@ -212,7 +222,8 @@ class Navigator:
         result's). Raises ValueError when the pose has no valid lattice node near it."""
         cfg = self.config.search
         lattice = self.lattice
-        adjacency = graph(lattice, state.penalty, cfg) if state.penalty.any() else self.graph
+        changed = state.penalty.any() or state.trusted.any()
+        adjacency = graph(lattice, state.penalty, cfg, state.trusted) if changed else self.graph
         paths, waypoints, current, cost = [], [], np.asarray(pose, np.float64)[[0, 1, 3]], 0.0
         for point in route:
             leg = search(lattice, current, point, cfg, adjacency=adjacency)
@@ -306,7 +317,8 @@ class Navigator:
             ) as own:
                 return self.run(queries, pool=own, done=done)
         self._done = done or (lambda k, result: None)
-        states = [_State(q, np.zeros(self.lattice.shape[:2])) for q in queries]
+        cells = self.lattice.shape[:2]
+        states = [_State(q, np.zeros(cells), np.zeros(cells, bool)) for q in queries]
         for k, state in enumerate(states):
             began = time.perf_counter()
             try:
@@ -367,6 +379,8 @@ class Navigator:
         # the plan returned: a successful one, else the one whose valid part ends nearest the goal
         if outcome.success or (last >= 0 and (state.best is None or outcome.final_distance < state.best[0])):
             state.best = (outcome.final_distance, result.plan, guide)
+        if last >= 0:
+            state.trusted |= self._cells_under(guide[: last + 1, :2])
         # where the generator stopped (None: it covered the whole guide, the policy stopped short)
         failure = None
         if not outcome.success and 0 <= last < total - 1:
@@ -447,6 +461,19 @@ class Navigator:
         state.guide = np.concatenate([guide[:begin], segment])
         state.segment_begin = begin
         return state.guide
+
+    def _cells_under(self, xy: np.ndarray) -> np.ndarray:
+        """[nx, ny] bool: lattice cells within `trust_radius` of any of the points [P, 2] (world)."""
+        lattice, radius = self.lattice, self.config.trust_radius
+        mask = np.zeros(lattice.shape[:2], bool)
+        reach = int(math.ceil(radius / lattice.resolution))
+        centre = lattice.cell_of(xy)  # [P, 2]
+        for di in range(-reach, reach + 1):
+            for dj in range(-reach, reach + 1):
+                cells = centre + np.array([di, dj])
+                near = lattice.inside(cells) & (np.hypot(*(lattice.position(cells) - xy).T) <= radius + 1e-9)
+                mask[cells[near, 0], cells[near, 1]] = True
+        return mask
 
     def _unreachable_text(self, state: _State) -> str:
         goal = state.query.goal

@@ -1,18 +1,26 @@
-"""Resolution-complete global search over the lattice: Dijkstra from the start's node.
+"""Resolution-complete global search over the lattice: A* from the start's node.
 
 The graph's nodes are the valid lattice nodes (cell, heading); its edges are
   - forward moves (cell -> cell + OFFSETS[h], same heading), where `Lattice.move_valid`;
-    cost: length x (1 + clearance_weight x shortfall + penalty of the cell entered), where
-    shortfall = max(0, 1 - clearance / clearance_scale) draws the path to the middle of a
-    passage without closing narrow ones (the bridge's strip keeps a finite cost);
+    cost: length x (1 + clearance_weight x shortfall + doubt_penalty where the move is
+    doubtful + penalty of the cell entered), where shortfall = max(0, 1 - clearance /
+    clearance_scale) draws the path to the middle of a passage without closing narrow ones
+    (the bridge's strip keeps a finite cost), and a doubtful move (ground only the relaxed
+    condition accepts, `lattice`) is taken only where no confident path is much shorter;
   - turns in place to the neighbouring heading (both nodes valid); cost: turn_cost x the
     angle (rad).
 The LeaS policy walks along its heading, so a path is a sequence of forward moves and turns.
-Dijkstra (SciPy's compiled csgraph) explores the whole reachable graph once: the answer is
-exact at the lattice's resolution (resolution-complete: a passage as wide as two cells is
-found whenever it is connected), and a goal no path reaches still yields the reachable node
-nearest to it (the best partial answer). A* would need a consistent heuristic to stay
-exact; with the whole reachable set wanted for partial answers it saves nothing here.
+
+A* runs as Dijkstra (SciPy's compiled csgraph) on costs reduced by a potential, the planar
+distance from a node's cell to the goal's disk: every edge costs at least the distance it
+moves (its multipliers are >= 1, turns move nothing), so the potential is consistent, reduced
+costs are >= 0, and Dijkstra on them expands exactly A*'s nodes in A*'s order. Expansion is
+bounded by SciPy's `limit` on the reduced distance, doubled until a goal node is settled: on
+a large scene the work stays near the corridor of the answer. The answer is exact at the
+lattice's resolution (resolution-complete: a passage as wide as two cells is found whenever
+it is connected). When no goal node is reachable, one unbounded run settles the whole
+reachable set and the path ends at the reachable node nearest the goal (the best partial
+answer).
 """
 
 from __future__ import annotations
@@ -37,6 +45,13 @@ class SearchConfig:
     start_radius: float = 0.15  # m: the start's node is the valid node nearest it within this
     goal_radius: float = 0.15  # m: goal nodes are the valid nodes within this of the goal
     waypoint_spacing: float = 0.5  # m of path between the waypoints given to the policy
+    # extra cost per m (on top of 1) of a doubtful move: a confident detour up to 4 x as long
+    # is preferred, so doubtful ground is offered where it saves a long way round or is the
+    # only way (the generator then judges it)
+    doubt_penalty: float = 3.0
+    # m of reduced cost (path cost over the straight line) the first A* round may spend; each
+    # further round doubles it
+    first_limit: float = 2.0
 
 
 @dataclass(frozen=True)
@@ -67,13 +82,15 @@ def _node_ids(shape) -> np.ndarray:
     return np.arange(nx * ny * nh).reshape(nx, ny, nh)
 
 
-def graph(lattice: Lattice, penalty: np.ndarray | None, config: SearchConfig):
+def graph(lattice: Lattice, penalty: np.ndarray | None, config: SearchConfig, trusted=None):
     """Sparse directed graph of the lattice (scipy.sparse csr, node id = (i * ny + j) * 16 + h).
 
     Args:
         lattice: the valid set.
         penalty: [nx, ny] extra cost per m of moving into each cell (failed regions), or None.
         config: costs.
+        trusted: [nx, ny] bool, cells where doubtful moves cost no doubt_penalty (ground the
+            contact generator has walked), or None.
     """
     from scipy import sparse
 
@@ -86,6 +103,10 @@ def graph(lattice: Lattice, penalty: np.ndarray | None, config: SearchConfig):
         ti, tj = i + dx, j + dy
         length = lattice.resolution * math.hypot(dx, dy)
         extra = config.clearance_weight * shortfall[ti, tj, h]
+        doubt = lattice.move_doubtful[i, j, h]
+        if trusted is not None:
+            doubt = doubt & ~trusted[ti, tj]
+        extra = extra + config.doubt_penalty * doubt
         if penalty is not None:
             extra = extra + penalty[ti, tj]
         rows.append(ids[i, j, h])
@@ -140,6 +161,59 @@ def goal_nodes(lattice: Lattice, goal, config: SearchConfig) -> np.ndarray:
     return np.array(out, np.int64)
 
 
+def potential(lattice: Lattice, goal, radius: float) -> np.ndarray:
+    """A*'s heuristic per node id: planar m from each cell centre to the disk of `radius` round
+    the goal (x, y), 0 inside it. A lower bound of any path's cost to a goal node (every move
+    costs at least its length) that changes along an edge by at most the edge's cost
+    (consistent). -> [nx * ny * 16] float."""
+    nx, ny, nh = lattice.shape
+    cells = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"), axis=-1)
+    gap = np.hypot(*(lattice.position(cells) - np.asarray(goal, np.float64)).transpose(2, 0, 1))
+    return np.repeat(np.maximum(gap - radius, 0.0).reshape(-1), nh)
+
+
+def astar(adjacency, source: int, goals: np.ndarray, heuristic: np.ndarray, first_limit: float):
+    """A* from `source` until a goal node is settled, as Dijkstra on reduced costs (host).
+
+    Args:
+        adjacency: csr graph with costs >= 0 (`graph`).
+        source: start node id.
+        goals: [G] goal node ids (may be empty).
+        heuristic: [N] consistent lower bound of the cost to a goal node (`potential`).
+        first_limit: reduced cost the first round may spend; each further round doubles it.
+
+    Returns:
+        (dist [N], pred [N]): costs from `source` (inf where not settled) and predecessors
+        (-9999 where none), exact for every settled node. Without a settled goal node the
+        last round is unbounded: every reachable node is settled.
+    """
+    from scipy import sparse
+    from scipy.sparse import csgraph
+
+    heads = np.repeat(np.arange(adjacency.shape[0]), np.diff(adjacency.indptr))
+    reduced = adjacency.data - heuristic[heads] + heuristic[adjacency.indices]
+    # >= 0 up to rounding; explicit zeros stay edges in a csr matrix
+    reduced = sparse.csr_matrix(
+        (np.maximum(reduced, 0.0), adjacency.indices, adjacency.indptr), shape=adjacency.shape
+    )
+    limit = float(first_limit) if len(goals) else np.inf
+    while True:
+        dist, pred = csgraph.dijkstra(
+            reduced, directed=True, indices=source, return_predecessors=True, limit=limit
+        )
+        settled = np.isfinite(dist)
+        if settled[goals].any() or not _frontier(reduced, heads, settled).any():
+            break  # a goal is settled, or every reachable node is
+        limit *= 2.0
+    return dist - heuristic[source] + heuristic, pred
+
+
+def _frontier(adjacency, heads: np.ndarray, settled: np.ndarray) -> np.ndarray:
+    """[E] bool: the edges of csr `adjacency` (`heads`: [E] each edge's tail node) that leave the
+    settled set [N] bool."""
+    return settled[heads] & ~settled[adjacency.indices]
+
+
 def _waypoints(path_xy: np.ndarray, spacing: float) -> np.ndarray:
     """Points of the path every `spacing` m of arc length (lattice nodes), its end last. -> [W, 2]."""
     keep = np.concatenate([[True], np.any(np.diff(path_xy, axis=0) != 0, axis=1)])
@@ -179,15 +253,15 @@ def search(
     Raises:
         ValueError: the start has no valid node near it.
     """
-    from scipy.sparse import csgraph
-
     goal = np.asarray(goal, np.float64).reshape(2)
     source = start_node(lattice, start, config)
     if source is None:
         raise ValueError(f"no valid lattice node within {config.start_radius} m of the start {start}")
     adjacency = graph(lattice, penalty, config) if adjacency is None else adjacency
-    dist, pred = csgraph.dijkstra(adjacency, directed=True, indices=source, return_predecessors=True)
     goals = goal_nodes(lattice, goal, config)
+    dist, pred = astar(
+        adjacency, source, goals, potential(lattice, goal, config.goal_radius), config.first_limit
+    )
     reason = None
     if len(goals) == 0:
         reason = "goal-invalid"

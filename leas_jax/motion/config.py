@@ -69,6 +69,11 @@ class SimulationConfig:
     # 0.06, far inside the explicit-PD stability bound of 2).
     omega: float = 62.8
     zeta: float = 1.0
+    # Leg joints hold the whole robot: their stiffness must exceed gravity's, m g h =
+    # 90.3 kg * 9.81 m/s^2 * 0.88 m = 780 N m/rad about an ankle, or a rigid stance tips
+    # over. Leg kp is at least `leg_stiffness`, N m/rad (4 x that), with kd for damping
+    # ratio `zeta` on the joint's own inertia.
+    leg_stiffness: float = 3000.0
     # Seconds simulated after the motion's last sample (the robot must stay up).
     settle: float = 0.5
     # Success: the root (base_link) stays above `min_root_height` over the higher sole in
@@ -81,6 +86,3 @@ class SimulationConfig:
     landing_position: float = 0.03
     landing_angle: float = 0.0873  # 5 deg
     max_slip: float = 0.01
-    # A sole counts as landed when its box touches the terrain within this time of the
-    # planned touch-down, s; the landing error is read at the end of the landing phase.
-    contact_force: float = 1.0  # N, normal force above which a geom pair counts as touching

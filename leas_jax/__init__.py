@@ -7,6 +7,9 @@ users do not pay for JAX start-up):
 """
 
 from leas_jax.lazy import lazy_getattr
+from leas_jax.quiet import silence_warp_notice
+
+silence_warp_notice()
 
 __version__ = "0.1.0"
 

@@ -146,7 +146,7 @@ def test_mj_ray_matches(case):
 
 
 def test_mjx_ray_matches(case):
-    from mujoco import mjx  # prints a harmless warning: mujoco_warp is not installed
+    from mujoco import mjx
 
     terrain, xy, reference = case
     model, data = mujoco_scene(terrain)

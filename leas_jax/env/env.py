@@ -8,17 +8,10 @@ data: build the env inside a jitted function from a traced field
 
 from __future__ import annotations
 
-import contextlib
-import io
-
 import jax
 import jax.numpy as jnp
+from brax.envs.base import Env, State
 from flax import struct
-
-# brax imports mujoco.mjx, whose optional GPU backend prints "Failed to import
-# warp" on machines without it; keep that noise out of the command line.
-with contextlib.redirect_stdout(io.StringIO()):
-    from brax.envs.base import Env, State
 
 from leas_jax.env import condition, heightmap, kinematics, reward
 from leas_jax.env.config import EnvConfig

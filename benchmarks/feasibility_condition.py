@@ -1,4 +1,4 @@
-"""Build, train and validate the learned feasibility condition (issue 19, item 1).
+"""Build, train and validate the learned feasibility condition.
 
 1. Data (benchmarks/feasibility_data.py, cached in .cache/ and rebuilt when the terrain,
    the generator's settings or its sources change): the contact generator's walking

@@ -1,5 +1,5 @@
-"""Ablation study of issue 19: does the learned condition, the planner in the loop, or both, make
-guides the contact generator can follow?
+"""Ablation study of the learned feasibility condition: does the learned condition, the planner in
+the loop, or both, make guides the contact generator can follow?
 
 Four methods, each trained from scratch with every seed of `--seeds`:
 

@@ -159,7 +159,7 @@ class EnvConfig:
     # docs/results/2026-12-04-learned-clearance). Hence the network by default.
     clearance_condition: str = "condition"
     reset_attempts: int = 4  # candidate poses drawn per reset; the first valid one is used
-    # Where resets start (issue 19): "condition", near grid points where `condition`'s
+    # Where resets start: "condition", near grid points where `condition`'s
     # cylinders hold for every yaw (the paper's resets), or "generator", at poses where the
     # Talos contact generator stands in double support: `spawn_yaws` random yaws at each of
     # those grid points, each verified (`leas_jax.feasibility.spawns`, cached per terrain and
@@ -168,7 +168,7 @@ class EnvConfig:
     # failed at their first pose (docs/results/2026-12-01-verified-spawns).
     spawns: str = "condition"
     spawn_yaws: int = 2  # "generator" spawns: yaws verified per grid point (5.3 ms CPU each)
-    # Termination condition (issue 19): "cylinders", the paper's reachability condition with
+    # Termination condition: "cylinders", the paper's reachability condition with
     # `reachability`'s cylinders and terms, or "learned", the network of
     # `leas_jax.env.learned_feasibility` trained on the contact generator's walking verdicts
     # (benchmarks/feasibility_condition.py), with its weights in `learned_weights` (an .npz,

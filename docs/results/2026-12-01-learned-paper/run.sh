@@ -1,6 +1,6 @@
 #!/bin/sh
 # The paper preset trained with the learned feasibility condition against the same preset with
-# the cylinders (issue 19): every command of docs/results/2026-12-01-learned-paper, in order.
+# the cylinders: every command of docs/results/2026-12-01-learned-paper, in order.
 # Run from the repository root with the package's environment on PATH.
 set -e
 D=docs/results/2026-12-01-learned-paper

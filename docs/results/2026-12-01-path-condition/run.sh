@@ -1,6 +1,6 @@
 #!/bin/sh
 # The learned condition refitted on the contact generator's whole-path verdicts, and the paper
-# preset trained with it (issue 19): every command of docs/results/2026-12-01-path-condition,
+# preset trained with it: every command of docs/results/2026-12-01-path-condition,
 # in order. Run from the repository root with the package's environment on PATH.
 set -e
 D=docs/results/2026-12-01-path-condition

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Generalisation of the paper preset between two training arenas (issue 22): every command
+# Generalisation of the paper preset between two training arenas: every command
 # of docs/results/2026-12-01-second-arena, in order. Run from the repository root.
 set -e
 D=docs/results/2026-12-01-second-arena

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 19's ablation at make run's scale: the learned condition relabelled on the current
+# The learned condition's ablation at make run's scale: the learned condition relabelled on the current
 # generator, then cylinders / learned condition, each with and without the planner phase,
 # 3 training seeds of the `quick` preset (80 M geometric env steps, 150 k kept planner steps).
 # Run from the repository root with the environment installed (`make venv`); 2 cores.

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 19's ablation on the current generator (retries, wider step search, refined planning
+# The learned condition's ablation on the current generator (retries, wider step search, refined planning
 # poses): cylinders / learned condition, each with and without the planner phase, 3 training
 # seeds of the `quick` preset (80 M geometric env steps, 150 k kept planner steps), 256 arena
 # starts x 2 evaluation seeds, every scenario. The learned condition is the shipped

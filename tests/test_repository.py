@@ -1,0 +1,46 @@
+"""The tracked files: they speak of the project's topics, never of tracker entries."""
+
+import re
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+THIS_FILE = Path(__file__).resolve().relative_to(ROOT).as_posix()
+
+# "issue 19", "Issue 22", "issues #3", "ticket 7", "PR #12", "pull request 4"
+TRACKER_REFERENCE = re.compile(r"\b(issues?|tickets?|PR|pull requests?)(\s+#?|\s*#)\d+\b", re.IGNORECASE)
+
+
+def tracked_files() -> list[str]:
+    """Paths (from the repository root) of the files git tracks that exist in the work tree."""
+    try:
+        listed = subprocess.run(
+            ["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True, timeout=60
+        ).stdout
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("not a git work tree")
+    return [p for p in listed.decode().split("\0") if p and (ROOT / p).is_file()]
+
+
+def tracker_references(text: str) -> list[str]:
+    """The tracker references in `text`, as written."""
+    return [match.group(0) for match in TRACKER_REFERENCE.finditer(text)]
+
+
+def test_the_pattern_finds_tracker_references():
+    text = "see issue 19 and Issue 22, issues #3, ticket 7, PR #12; label #0, the issues, base64 +PR0a"
+    assert tracker_references(text) == ["issue 19", "Issue 22", "issues #3", "ticket 7", "PR #12"]
+
+
+def test_no_tracked_file_refers_to_the_tracker():
+    found = {}
+    for path in tracked_files():
+        data = (ROOT / path).read_bytes()
+        if path == THIS_FILE or b"\0" in data[:8192]:  # this file's examples; binary files
+            continue
+        references = tracker_references(data.decode("utf-8", errors="replace"))
+        if references:
+            found[path] = references
+    assert found == {}

@@ -11,6 +11,9 @@ triangle a vertical line meets, so meshes with inverted or inconsistent normals,
 edges (no inside needed) and duplicate faces (the maximum is idempotent) give the same
 heights as clean ones. Vertical triangles (no area seen from above) are skipped: the
 line through a wall meets the wall's top edge, which belongs to the triangle above it.
+A wall stored in float32 keeps a sliver of projected area and is kept; a line that
+meets a triangle only within EDGE_TOL of its edges gets a height of the triangle (see
+`_heights_on`), so no line gets a height beyond the heights of the corners it meets.
 
 Support surfaces follow HPP's affordance extraction (hpp-affordance: the triangles whose
 normal passes the support requirement, grown through shared edges into surfaces of one
@@ -110,7 +113,7 @@ def _edge_setup(tri: np.ndarray):
     Returns:
         (keep [F] bool (projected area above MIN_PROJECTED_AREA), coefficients [F', 3, 3]
          (per edge: ex, ey, c with w = ex x + ey y + c, sign-corrected), z [F', 3] the
-         corner heights, area2 [F'] the doubled signed projected area).
+         corner heights).
     """
     a, b, c = tri[:, 0, :2], tri[:, 1, :2], tri[:, 2, :2]
     area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
@@ -127,19 +130,26 @@ def _edge_setup(tri: np.ndarray):
         ey = d[:, 0] * sign / length
         c0 = (d[:, 1] * p[:, 0] - d[:, 0] * p[:, 1]) * sign / length
         coeffs.append(np.stack([ex, ey, c0], axis=1))
-    return keep, np.stack(coeffs, axis=1), tri[keep][:, :, 2], area2
+    return keep, np.stack(coeffs, axis=1), tri[keep][:, :, 2]
 
 
-def _heights_on(coeffs, z, area2, lengths_tri, x, y, t):
+def _heights_on(coeffs, z, lengths_tri, x, y, t):
     """Heights of triangles t at points (x, y), nan where the point is outside.
 
     Barycentric weights are the edge functions times the opposite edge's length over
-    the doubled area, so z = sum_k w_k len_k z_k / |area2|.
+    the doubled area (their sum), so z = sum_k w_k len_k z_k / sum_k w_k len_k. A point
+    up to EDGE_TOL outside a triangle counts as on it: its negative edge functions are
+    taken as 0, which moves it onto the triangle, and its height is a weighted mean of
+    the corner heights, within their range. (The weights then sum to more than the
+    doubled area, itself above 2 MIN_PROJECTED_AREA.) Extrapolated instead, the height
+    grows with len / area, without bound for a triangle seen nearly edge-on from above:
+    a vertical face stored in float32 keeps a projected area of 1e-9 m^2, and points
+    beside such faces got heights of 68 m on a scene 0.18 m high.
     """
     w = coeffs[t, :, 0] * x[:, None] + coeffs[t, :, 1] * y[:, None] + coeffs[t, :, 2]  # [P, 3]
     inside = np.all(w >= -EDGE_TOL, axis=1)
-    bary = w * lengths_tri[t] / np.abs(area2[t])[:, None]
-    height = np.einsum("pk,pk->p", bary, z[t])
+    weights = np.maximum(w, 0.0) * lengths_tri[t]
+    height = np.einsum("pk,pk->p", weights, z[t]) / weights.sum(axis=1)
     return np.where(inside, height, np.nan)
 
 
@@ -157,7 +167,7 @@ class MeshIndex:
         meshes = tuple(meshes)
         tri = [m.triangles for m in meshes]
         self.triangles = np.concatenate(tri) if tri else np.zeros((0, 3, 3))
-        keep, self._coeffs, self._z, self._area2 = _edge_setup(self.triangles)
+        keep, self._coeffs, self._z = _edge_setup(self.triangles)
         flat = self.triangles[keep]
         # Opposite-edge lengths of the projection, per corner (barycentric weights).
         a, b, c = flat[:, 0, :2], flat[:, 1, :2], flat[:, 2, :2]
@@ -210,7 +220,7 @@ class MeshIndex:
             j = j0[t] + local % width[t]
             x = bounds[0, 0] + i * resolution
             y = bounds[0, 1] + j * resolution
-            height = _heights_on(self._coeffs, self._z, self._area2, self._lengths, x, y, t)
+            height = _heights_on(self._coeffs, self._z, self._lengths, x, y, t)
             hit = ~np.isnan(height)
             np.maximum.at(top, (i * ny + j)[hit], height[hit])
         return top.reshape(nx, ny)
@@ -262,7 +272,7 @@ class MeshIndex:
         point = np.repeat(valid, counts)
         offset = np.arange(len(point)) - np.repeat(np.cumsum(counts) - counts, counts)
         t = tri_ids[np.repeat(starts[cell[valid]], counts) + offset]
-        height = _heights_on(self._coeffs, self._z, self._area2, self._lengths, xy[point, 0], xy[point, 1], t)
+        height = _heights_on(self._coeffs, self._z, self._lengths, xy[point, 0], xy[point, 1], t)
         hit = ~np.isnan(height)
         np.maximum.at(top, point[hit], height[hit])
         return top

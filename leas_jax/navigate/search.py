@@ -205,7 +205,7 @@ def astar(adjacency, source: int, goals: np.ndarray, heuristic: np.ndarray, firs
         if settled[goals].any() or not _frontier(reduced, heads, settled).any():
             break  # a goal is settled, or every reachable node is
         limit *= 2.0
-    return dist - heuristic[source] + heuristic, pred
+    return dist + heuristic[source] - heuristic, pred
 
 
 def _frontier(adjacency, heads: np.ndarray, settled: np.ndarray) -> np.ndarray:

@@ -1,0 +1,235 @@
+"""Navigate's global layer on rough ground: doubtful nodes offered at a cost and judged by the
+generator on demand, the step model, cracks, and A* against plain Dijkstra.
+
+The closed-loop tests inject `plan_fn` (the pool's test hook): stand-ins for the generator that
+either walk every guide or stop where a guide enters the rough strip, so they check what the
+loop does with the verdicts, in seconds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from leas_jax.contacts.plan import coverage_of
+from leas_jax.contacts.validation.pool import ValidationPool
+from leas_jax.navigate import result as reasons
+from leas_jax.navigate.lattice import LatticeConfig, build_lattice, heading_index
+from leas_jax.navigate.loop import NavigateConfig, Navigator
+from leas_jax.navigate.search import SearchConfig, goal_nodes, graph, search, start_node
+from leas_jax.terrain import load_terrain, loads_terrain
+
+ROOT = Path(__file__).resolve().parents[1]
+SHIPPED = ROOT / "checkpoints" / "leas_talos"
+ROUGH_X = (3.0, 4.2)  # m: the rough strip of ROUGH_STRIP spans these x
+
+
+def _tiles(width_y: float, y0: float) -> str:
+    """Boxes of a strip of 0.3 m tiles across x in ROUGH_X, pitched +-20 deg in turn."""
+    out = []
+    for k, x in enumerate(np.arange(ROUGH_X[0] + 0.15, ROUGH_X[1], 0.3)):
+        pitch = 0.35 if k % 2 == 0 else -0.35
+        out.append(
+            f"[[box]]\ncenter = [{x:.2f}, {y0 + width_y / 2:.2f}, -0.05]\n"
+            f"size = [0.3, {width_y:.2f}, 0.1]\nrpy = [0.0, {pitch}, 0.0]\n"
+        )
+    return "\n".join(out)
+
+
+def _slab(name: str, tiles: str, extra: str = "") -> str:
+    """An 8 x 3 m slab with its top at 0, a gap for the tiles in ROUGH_X over the full width."""
+    return f"""
+name = "{name}"
+bounds = [[0.0, 0.0], [8.0, 3.0]]
+void_height = -2.0
+resolution = 0.02
+[[box]]
+center = [1.5, 1.5, -0.1]
+size = [3.0, 3.0, 0.2]
+[[box]]
+center = [6.1, 1.5, -0.1]
+size = [3.8, 3.0, 0.2]
+{tiles}
+{extra}
+"""
+
+
+# The tiles cover the whole width: every way to the goal crosses doubtful ground.
+ROUGH_STRIP = _slab("rough_strip", _tiles(3.0, 0.0))
+# The tiles cover y 0..2.2; a flat lane (y 2.2..3) goes round them.
+ROUGH_WITH_LANE = _slab(
+    "rough_with_lane",
+    _tiles(2.2, 0.0),
+    "[[box]]\ncenter = [3.6, 2.6, -0.1]\nsize = [1.2, 0.8, 0.2]\n",
+)
+
+STEPS = """
+name = "steps"
+bounds = [[0.0, 0.0], [8.0, 3.0]]
+void_height = -2.0
+resolution = 0.02
+[[box]]
+center = [4.0, 1.5, -0.1]
+size = [8.0, 3.0, 0.2]
+[[box]]
+center = [5.0, 1.5, {half}]
+size = [6.0, 3.0, {height}]
+"""
+
+CRACKS = """
+name = "cracks"
+bounds = [[0.0, 0.0], [8.0, 3.0]]
+void_height = -2.0
+resolution = 0.02
+[[box]]
+center = [1.5, 1.5, -0.1]
+size = [3.0, 3.0, 0.2]
+[[box]]
+center = [3.53, 1.5, -0.1]
+size = [1.0, 3.0, 0.2]
+[[box]]
+center = [6.0, 1.5, -0.1]
+size = [3.0, 3.0, 0.2]
+"""  # a 0.06 m crack at x 3.0..3.06, a 0.47 m gap at x 4.03..4.5
+
+
+@pytest.fixture(scope="module")
+def policy():
+    from leas_jax.training import load_policy
+
+    return load_policy(SHIPPED)
+
+
+def _lattice(policy, terrain, **config):
+    from leas_jax.env import heightfield_from_terrain
+
+    env = policy.config.env
+    field = heightfield_from_terrain(terrain, env)
+    return build_lattice(
+        field, terrain.bounds, env.nominal_root_height, env.reachability, LatticeConfig(**config)
+    )
+
+
+def _valid_at(lattice, xy, heading: float = 0.0) -> bool:
+    i, j = lattice.cell_of(np.asarray(xy))
+    return bool(lattice.node_valid[i, j, heading_index(heading)])
+
+
+def test_rough_tiles_are_doubtful_not_invalid_and_only_offered_when_asked(policy):
+    terrain = loads_terrain(ROUGH_STRIP)
+    lattice = _lattice(policy, terrain)
+    i0, i1 = lattice.cell_of(np.array([[ROUGH_X[0] + 0.1, 0.5], [ROUGH_X[1] - 0.1, 2.5]]))
+    strip = lattice.node_valid[i0[0] : i1[0], i0[1] : i1[1], 0]
+    doubt = lattice.doubtful[i0[0] : i1[0], i0[1] : i1[1], 0]
+    assert strip.mean() > 0.5 and doubt[strip].mean() > 0.5, "the tiles: valid, mostly doubtful"
+    (a, b), (c, d) = lattice.cell_of(np.array([[0.5, 0.5], [2.4, 2.5]]))
+    assert not lattice.doubtful[a:c, b:d].any(), "the flat slab's inside is confident"
+    found = search(lattice, (1.0, 1.5, 0.0), (6.0, 1.5))
+    assert found.reached
+    confident_only = _lattice(policy, terrain, offer_doubtful=False)
+    assert not confident_only.doubtful.any()
+    assert not search(confident_only, (1.0, 1.5, 0.0), (6.0, 1.5)).reached
+
+
+def _doubtful_nodes(lattice, path) -> int:
+    """How many nodes of a search path [P, 3] (x, y, yaw) are doubtful."""
+    i, j = lattice.cell_of(path[:, :2]).T
+    return int(lattice.doubtful[i, j, heading_index(path[:, 2])].sum())
+
+
+def test_a_confident_detour_is_preferred_to_doubtful_ground(policy):
+    lattice = _lattice(policy, loads_terrain(ROUGH_WITH_LANE))
+    cheap = search(lattice, (1.0, 1.0, 0.0), (6.0, 1.0), SearchConfig(doubt_penalty=0.0))
+    dear = search(lattice, (1.0, 1.0, 0.0), (6.0, 1.0))
+    assert cheap.reached and dear.reached
+    assert _doubtful_nodes(lattice, cheap.path) > 5, "without the doubt's cost: across the tiles"
+    assert _doubtful_nodes(lattice, dear.path) == 0, "with it: round them by the flat lane"
+    assert dear.length > cheap.length + 0.5
+
+
+@pytest.mark.parametrize("height, crosses", [(0.15, True), (0.40, False)])
+def test_the_step_model_bounds_a_riser(policy, height, crosses):
+    terrain = loads_terrain(STEPS.format(half=height / 2, height=height))
+    lattice = _lattice(policy, terrain)
+    assert _valid_at(lattice, (1.0, 1.5)) and _valid_at(lattice, (6.0, 1.5)), "both treads"
+    found = search(lattice, (1.0, 1.5, 0.0), (6.0, 1.5))
+    assert found.reached == crosses
+    if not crosses:
+        assert found.reason == reasons.NO_PATH and found.path[:, 0].max() < 2.2
+
+
+def test_a_crack_counts_as_ground_a_gap_and_a_platform_edge_do_not(policy):
+    lattice = _lattice(policy, loads_terrain(CRACKS))
+    assert _valid_at(lattice, (3.03, 1.5)), "over the 0.06 m crack"
+    assert not _valid_at(lattice, (4.25, 1.5)), "over the 0.47 m gap"
+    assert not _valid_at(lattice, (4.08, 1.5)) and not _valid_at(lattice, (4.45, 1.5)), "past its edges"
+    assert search(lattice, (1.0, 1.5, 0.0), (3.8, 1.5)).reached
+    assert not search(lattice, (1.0, 1.5, 0.0), (6.0, 1.5)).reached
+
+
+def test_astar_finds_dijkstras_cost_and_path_length(policy):
+    from scipy.sparse import csgraph
+
+    terrain = load_terrain(ROOT / "terrains" / "eval_hole.toml")
+    lattice = _lattice(policy, terrain)
+    config = SearchConfig()
+    adjacency = graph(lattice, None, config)
+    for start, goal in [((2.0, 4.0, 0.0), terrain.scenario.target), ((1.0, 1.0, 1.0), (8.0, 7.0))]:
+        found = search(lattice, start, goal, config, adjacency=adjacency)
+        source = start_node(lattice, start, config)
+        dist = csgraph.dijkstra(adjacency, indices=source)
+        best = dist[goal_nodes(lattice, goal, config)].min()
+        assert found.reached and found.cost == pytest.approx(best, rel=1e-9, abs=1e-9)
+
+
+@dataclass(frozen=True)
+class StandInPlan:
+    """What metrics and the loop read of a plan: posture roots, coverage, last valid index."""
+
+    q: np.ndarray
+    coverage: float
+    last_valid_index: int
+
+
+def _plan_until(guide, last: int) -> StandInPlan:
+    picks = np.unique(np.append(np.arange(0, last + 1, 5), last))
+    q = np.zeros((len(picks), 39))
+    q[:, :3] = guide[picks, :3]
+    return StandInPlan(q, coverage_of(guide, last), last)
+
+
+def walks_everything(terrain, guide, timestep, config):
+    """A generator that covers every guide."""
+    return _plan_until(guide, len(guide) - 1)
+
+
+def refuses_the_tiles(terrain, guide, timestep, config):
+    """A generator that stops before the first guide pose on the rough strip."""
+    inside = np.flatnonzero((guide[:, 0] > ROUGH_X[0]) & (guide[:, 0] < ROUGH_X[1]))
+    return _plan_until(guide, len(guide) - 1 if len(inside) == 0 else max(int(inside[0]) - 1, 0))
+
+
+def _navigate(policy, plan_fn, **config):
+    terrain = loads_terrain(ROUGH_STRIP)
+    navigator = Navigator(policy, terrain, NavigateConfig(**config))
+    query = navigator.query((1.0, 1.5, 0.0), (6.0, 1.5))
+    with ValidationPool(terrain, workers=0, plan_fn=plan_fn, return_plans=True) as pool:
+        (result,) = navigator.run([query], pool=pool)
+    return result
+
+
+def test_doubtful_ground_is_walked_when_the_generator_walks_it(policy):
+    result = _navigate(policy, walks_everything)
+    assert result.success and result.reason == reasons.REACHED, result.message
+    assert result.replans == 0 and result.guide[:, 0].max() > ROUGH_X[1]
+
+
+def test_doubtful_ground_is_refused_when_the_generator_does_not(policy):
+    result = _navigate(policy, refuses_the_tiles, max_replans=2)
+    assert not result.success and result.reason == reasons.REPLAN_LIMIT, result.message
+    assert result.replans == 2 and all(a.failure is not None for a in result.attempts)
+    assert result.plan.q[:, 0].max() <= ROUGH_X[0], "no verified posture on the tiles"
+    assert "after 2 replans" in result.message

@@ -1,4 +1,5 @@
-"""The tracked files: they speak of the project's topics, never of tracker entries."""
+"""The tracked files: they speak of the project's topics, never of tracker entries, and the
+results under docs/ stay light (bulky data is written again by the command its README gives)."""
 
 import re
 import subprocess
@@ -8,6 +9,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 THIS_FILE = Path(__file__).resolve().relative_to(ROOT).as_posix()
+
+DOCS_FILE_LIMIT = 2_000_000  # bytes
 
 # "issue 19", "Issue 22", "issues #3", "ticket 7", "PR #12", "pull request 4"
 TRACKER_REFERENCE = re.compile(r"\b(issues?|tickets?|PR|pull requests?)(\s+#?|\s*#)\d+\b", re.IGNORECASE)
@@ -44,3 +47,9 @@ def test_no_tracked_file_refers_to_the_tracker():
         if references:
             found[path] = references
     assert found == {}
+
+
+def test_no_tracked_file_under_docs_is_over_the_limit():
+    sizes = {path: (ROOT / path).stat().st_size for path in tracked_files() if path.startswith("docs/")}
+    assert sizes, "no tracked file under docs/"
+    assert {path: size for path, size in sizes.items() if size > DOCS_FILE_LIMIT} == {}

@@ -2,11 +2,16 @@
 
     leas navigate --checkpoint DIR --terrain FILE --start X,Y,YAW --goal X,Y --out plan.npz
                   [--html view.html] [--via X,Y ...] [--workers N] [--max-replans K]
+                  [--motion motion.npz]
 
 Progress goes to stderr, one line per step; the summary to stdout. The plan file is the
 docs/design.md §6 format (`ContactPlan.save`), so `leas verify` and `leas show` read it.
 Exit code 0: the goal is reached; 1: it is not (the best partial plan is written when the
-generator verified any posture); 2: bad input. Module-level imports stay light (no JAX):
+generator verified any posture); 2: bad input. With `--motion`, a reached plan is also made
+into a whole-body motion and simulated in MuJoCo (`leas_jax.motion.execute`): one line gives
+the verdict (fallen or not, worst landing error, slip, torque ratio) or the phase that cannot
+be made and why; the exit code is 1 unless the motion is made and executes (as `leas motion`
+and `leas simulate` say). Module-level imports stay light (no JAX):
 the CLI imports every command module to build its parser.
 """
 
@@ -51,6 +56,7 @@ def cmd_navigate(args) -> int:
     """Run one navigate query; write the plan (and the HTML view). Returns the exit code."""
     out = _check_output("--out", args.out, ".npz")
     html = None if args.html is None else _check_output("--html", args.html, ".html")
+    motion_out = None if args.motion is None else _check_output("--motion", args.motion, ".npz")
     if args.workers < 0:
         raise UsageError(f"--workers: expected an integer >= 0, got {args.workers}")
     config = navigate_config(args)
@@ -103,7 +109,23 @@ def cmd_navigate(args) -> int:
 
         write_html(result.plan, html)
         print(f"wrote {html}")
-    return 0 if result.success else 1
+    if motion_out is None:
+        return 0 if result.success else 1
+    return _execute(result, motion_out)
+
+
+def _execute(result, motion_out: Path) -> int:
+    """Make and simulate the motion of a reached plan; one line on stdout; the exit code."""
+    if not result.success:
+        print(f"{motion_out}: no motion: the goal is not reached")
+        return 1
+    from leas_jax.motion.execute import execute_plan
+
+    execution = execute_plan(result.plan)
+    if execution.motion is not None:
+        execution.motion.save(motion_out)
+    print(f"{motion_out}: {execution.line()}")
+    return 0 if execution.success else 1
 
 
 def register(subparsers) -> None:
@@ -130,6 +152,12 @@ def register(subparsers) -> None:
     )
     parser.add_argument("--out", required=True, metavar="PLAN.npz", help="contact plan file")
     parser.add_argument("--html", metavar="VIEW.html", help="also write the 3D view of the plan")
+    parser.add_argument(
+        "--motion",
+        metavar="MOTION.npz",
+        help="make the reached plan's whole-body motion, simulate it in MuJoCo and write it here "
+        "(exit 1 when it cannot be made or does not execute)",
+    )
     parser.add_argument("--degrees", action="store_true", help="YAW of --start is in degrees")
     parser.add_argument("--speed", type=float, default=0.0, help="initial speed along the heading (m/s)")
     parser.add_argument(

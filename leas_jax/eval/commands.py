@@ -10,6 +10,9 @@ from leas_jax.eval.scenarios import METHODS
 from leas_jax.terrain.generate import SCENARIOS
 from leas_jax.terrain.loader import MAX_STARTS
 
+# Plans per scenario and method that `--motion` makes into motions and simulates by default.
+MOTION_PLANS = 3
+
 
 def _positive_int(name: str, allow_zero: bool = False, maximum: int | None = None):
     def parse(text: str) -> int:
@@ -72,6 +75,9 @@ def cmd_evaluate(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out!r} exists and is not a directory")
+    if args.motion_plans is not None and not args.motion:
+        raise UsageError("--motion-plans: give --motion too")
+    motion_plans = (args.motion_plans or MOTION_PLANS) if args.motion else 0
     report = evaluate(
         scenarios,
         parse_methods(args.methods),
@@ -84,6 +90,7 @@ def cmd_evaluate(args) -> int:
         address=args.ray_address,
         leas_stop_at_invalid=args.leas_stop_at_invalid,
         rbkino_timestep=args.rbkino_timestep,
+        motion_plans=motion_plans,
     )
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))
@@ -92,6 +99,14 @@ def cmd_evaluate(args) -> int:
             print(
                 f"{row['scenario']:12s} {row['method']:11s} n={row['n']:3d} coverage {row['coverage']:5.1f}% "
                 f"success {row['success']:5.1f}%"
+            )
+    for name, scenario in report["scenarios"].items():
+        for method, s in scenario.get("motion", {}).get("summary", {}).items():
+            worst = s["max_landing_position_m"]
+            print(
+                f"{name:12s} {method:11s} motions: {s['made']}/{s['n']} made, {s['without_fall']} without a fall, "
+                f"{s['executed']} executed; max landing error "
+                + ("-" if worst is None else f"{worst * 100:.2f} cm / {s['max_landing_angle_deg']:.2f} deg")
             )
     print(
         f"{report['seconds']:.1f} s -> {out}/results.json, table.md, table.csv, guides.npz, "
@@ -208,6 +223,19 @@ def register(subparsers) -> None:
         help="s between the poses of RBKino's and RBKino+RRT's paths handed to the contact generator "
         "(default 0.01, as HPP's generator samples a path; 0.1, the env's, costs about a third of the "
         "contact planning but the generator then cannot follow RBKino's turns from starts turned away)",
+    )
+    parser.add_argument(
+        "--motion",
+        action="store_true",
+        help="also make a few of each scenario's LeaS and navigate plans that cover their guide into "
+        "whole-body motions and simulate them in MuJoCo (results.json's `motion`, table.md)",
+    )
+    parser.add_argument(
+        "--motion-plans",
+        type=_positive_int("--motion-plans"),
+        default=None,
+        metavar="N",
+        help=f"plans per scenario and method that --motion executes (default {MOTION_PLANS})",
     )
     parser.set_defaults(func=cmd_evaluate)
 

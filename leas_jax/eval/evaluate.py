@@ -14,7 +14,9 @@ the RRT's validity checks are jitted JAX):
    generator samples a path), the others one pose every env timestep;
 3. validate every other guide with the contact generator in one worker pool per
    terrain, with a progress bar;
-4. compute coverage and success per trajectory (`metrics`) and aggregate.
+4. compute coverage and success per trajectory (`metrics`) and aggregate;
+5. with `motion_plans`, make a few covered LeaS and navigate plans into whole-body
+   motions and simulate them in MuJoCo (`leas_jax.eval.motions`).
 
 A method that produces no guide for a start (the RRT found no path within
 its budget) counts as coverage 0, not a success, with error "rrt: no path";
@@ -67,6 +69,7 @@ class Trajectory:
         replans: navigate's searches after the first (None for the other methods).
         timestep: s between the guide's poses (None: the env's, `validate`'s `timestep`);
             RBKino's continuous paths are sampled finer (`BaselineConfig.rbkino_timestep`).
+        plan: the generator's `ContactPlan` once validated (None: no plan).
     """
 
     cell: int
@@ -80,11 +83,13 @@ class Trajectory:
     error: str | None = None
     replans: int | None = None  # navigate: searches after the first
     timestep: float | None = None
+    plan: object | None = None
 
 
 @dataclass
 class ScenarioResult:
-    """All trajectories of one scenario, with its terrain and cells."""
+    """All trajectories of one scenario, with its terrain and cells; `motions`: the executed
+    plans' figures (`motions.run_motions`), None when no motion was asked for."""
 
     name: str
     terrain: object
@@ -92,6 +97,7 @@ class ScenarioResult:
     methods: tuple[str, ...]
     trajectories: list[Trajectory] = dataclass_field(default_factory=list)
     seconds: dict = dataclass_field(default_factory=dict)
+    motions: list | None = None
 
     def summary(self) -> dict:
         """{method: {cell name: metrics.summarize(...), "all": ...}}."""
@@ -225,7 +231,8 @@ def _navigate_trajectories(
     """Navigate from every start through the route `points` (closed loop, its own pool).
 
     Returns:
-        ([(guide or None, waypoints, outcome)] per start, seconds per navigate part summed).
+        ([(guide or None, waypoints, outcome, replans, plan or None)] per start, seconds per
+        navigate part summed).
     """
     from tqdm.auto import tqdm
 
@@ -249,7 +256,7 @@ def _navigate_trajectories(
             outcome = metrics.outcome(
                 answer.guide, points[-1], plan.coverage, plan.last_valid_index, plan=plan
             )
-        out.append((answer.guide, answer.waypoints, outcome, answer.replans))
+        out.append((answer.guide, answer.waypoints, outcome, answer.replans, answer.plan))
     return out, seconds
 
 
@@ -378,7 +385,7 @@ def build_trajectories(
             answers, parts = _navigate_trajectories(
                 policy, terrain, starts, points, rrt_workers, address, progress
             )
-            for n, (guide, waypoints, outcome, replans) in enumerate(answers):
+            for n, (guide, waypoints, outcome, replans, plan) in enumerate(answers):
                 trajectories.append(
                     Trajectory(
                         cell=k,
@@ -391,6 +398,7 @@ def build_trajectories(
                         outcome=outcome,
                         error=outcome.error,
                         replans=replans,
+                        plan=plan,
                     )
                 )
             seconds["navigate"] += time.perf_counter() - began
@@ -437,6 +445,7 @@ def validate(
             for future in concurrent.futures.as_completed(futures):
                 t = futures[future]
                 (result,) = future.result()
+                t.plan = result.plan
                 t.outcome = metrics.outcome(
                     t.guide,
                     target,
@@ -560,6 +569,7 @@ def evaluate(
     address: str | None = None,
     leas_stop_at_invalid: bool = False,
     rbkino_timestep: float | None = None,
+    motion_plans: int = 0,
 ) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
@@ -588,6 +598,9 @@ def evaluate(
             that the generator then walks).
         rbkino_timestep: s between the poses of RBKino's and RBKino+RRT's paths (None:
             `BaselineConfig.rbkino_timestep`, 0.01 s as HPP's contact generator samples a path).
+        motion_plans: per scenario and method among leas and navigate, make at most this
+            many plans that cover their guide into motions and simulate them in MuJoCo
+            (`leas_jax.eval.motions`; results.json's `motion`, table.md's motion table; 0: none).
 
     Returns:
         the results dictionary written to results.json.
@@ -637,6 +650,14 @@ def evaluate(
                 leas_stop_at_invalid=leas_stop_at_invalid,
             )
         )
+        if motion_plans > 0:
+            from leas_jax.eval.motions import run_motions
+
+            began_motions = time.perf_counter()
+            results[-1].motions = run_motions(
+                results[-1].trajectories, motion_plans, workers or 0, progress, desc=f"{name}: motions"
+            )
+            results[-1].seconds["motion"] = time.perf_counter() - began_motions
     report = tables.results_dict(
         results, policy=policy, seconds=time.perf_counter() - began, leas_stop_at_invalid=leas_stop_at_invalid
     )

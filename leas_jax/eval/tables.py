@@ -122,6 +122,13 @@ def results_dict(results, policy=None, seconds: float = 0.0, leas_stop_at_invali
             "seconds": {k: round(v, 3) for k, v in result.seconds.items()},
             "trajectories": trajectories,
         }
+        if result.motions is not None:
+            from leas_jax.eval.motions import aggregate
+
+            report["scenarios"][result.name]["motion"] = {
+                "executions": result.motions,
+                "summary": aggregate(result.motions),
+            }
     report["rows"] = [
         {k: (_number(v) if isinstance(v, float) else v) for k, v in r.items()} for r in rows(results)
     ]
@@ -204,6 +211,9 @@ def markdown(report: dict) -> str:
             f"| {_pct(r['coverage'])} | {_pct(r['success'])} | {r['errors']} |"
         )
     parts.append("")
+    from leas_jax.eval.motions import markdown as motion_markdown
+
+    parts += motion_markdown(report, METHOD_LABELS)
     seconds = {name: s["seconds"] for name, s in report["scenarios"].items()}
     parts += [
         "Wall time (s): "

@@ -1,5 +1,7 @@
 """Static equilibrium: hpp-centroidal-dynamics LP vs our SciPy LP, and hand-computed cases."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -7,6 +9,12 @@ from leas_jax.contacts.robot import equilibrium as E
 from leas_jax.contacts.robot.model import quat_xyzw_from_matrix, rotz
 
 MASS = 90.27  # kg, Talos (computeTotalMass of the example-robot-data model)
+# Sole placements [42, 2, 7] (NaN rows in the air) and CoMs [42, 3] of the postures of
+# `leas navigate --checkpoint checkpoints/leas_talos --terrain
+# terrains/hpp/demos/talos_stairs15.toml --start=-1.9,1.9,-90 --degrees --goal=-1.9,0.9`.
+# qpOASES solves the double-support stances 6 and 7 hot-started from another double
+# support but not from a cold start (a new object, or after the single-support 5).
+STAIRS15 = Path(__file__).parent / "data" / "talos_stairs15_stances.npz"
 
 
 def _foot(x, y, z, rot=None):
@@ -58,6 +66,18 @@ def test_parity_with_hpp_centroidal_dynamics(hpp, name):
     assert signs == {True, False}  # each stance has CoMs inside and outside
 
 
+def test_plan_stances_match_scipy_in_any_order():
+    """Each stance of a plan has SciPy's robustness, on one object in plan order (single
+    and double support alternating) and on a fresh object per stance."""
+    data = np.load(STAIRS15)
+    reused = E.HppEquilibrium(MASS)
+    for k, (feet, com) in enumerate(zip(data["feet"], data["com"])):
+        points, normals = E.sole_corners(feet)
+        expected = E.static_equilibrium_lp(points, normals, com, MASS)
+        assert reused.feet_robustness(feet, com) == pytest.approx(expected, rel=1e-5), k
+        assert E.HppEquilibrium(MASS).feet_robustness(feet, com) == pytest.approx(expected, rel=1e-5), k
+
+
 def test_hand_computed_double_support():
     """Two flat 0.20 x 0.13 soles centred at y = +-0.085: the support polygon spans
     y in [-0.15, 0.15], x in [-0.1, 0.1]. A CoM at y = 0.14 is 1 cm inside (balanced),
@@ -91,6 +111,8 @@ def test_sole_corners():
 
 def test_no_contact_is_not_balanced(hpp):
     assert hpp.feet_robustness(np.full((2, 7), np.nan), np.zeros(3)) == -np.inf
+    with pytest.raises(RuntimeError, match="set_contacts"):
+        E.HppEquilibrium(MASS).robustness(np.zeros(3))
 
 
 def test_missing_library_message(monkeypatch):

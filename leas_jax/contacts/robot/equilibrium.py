@@ -5,6 +5,7 @@ robustness >= 0 by the linear program of hpp-centroidal-dynamics over the sole
 corners (mu = 0.5). `sole_corners` gives those contact points; `HppEquilibrium` wraps
 the library; `static_equilibrium_lp` is an independent formulation with SciPy's
 `linprog` used to cross-check it (tests/test_contacts_equilibrium.py).
+qpOASES solves the library's LPs, CLP those qpOASES fails on (`HppEquilibrium`).
 
 The library's Python module does not find its shared libraries by itself (they live
 in the cmeel prefix, which is not on the loader path), so `_import_hpp_centroidal_dynamics`
@@ -106,22 +107,50 @@ def sole_corners(feet: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class HppEquilibrium:
     """Robustness of static equilibrium with hpp-centroidal-dynamics (LP algorithm).
 
-    Host-only, not jittable; holds a solver object, one per process/thread.
+    Host-only, not jittable; holds solver objects, one per process/thread.
 
     The LP (hpp-centroidal-dynamics `EQUILIBRIUM_ALGORITHM_LP`) finds generator
     coefficients b of the linearised friction cones with G b = D c + d (Newton-Euler
     of a static body of mass m at CoM c) maximising b0 <= min(b); the robustness is
     b0 >= 0 when the CoM is in equilibrium, negative when not.
+
+    qpOASES solves it by default. hpp-centroidal-dynamics hot-starts qpOASES from the
+    previous LP of the same size and starts it cold on a new object, after a change in
+    the number of contact points (it then makes a new qpOASES problem) or after a
+    failure; from a cold start qpOASES fails on some stances that have an optimum
+    ("Initialisation failed", status LP_STATUS_ERROR), so its answer would depend on the
+    stances checked before. Every LP qpOASES leaves without an optimum is solved again
+    by CLP's simplex (a second Equilibrium, made at the first such LP): the robustness
+    then depends on the stance alone, and CLP runs only where qpOASES fails.
+
+    Args:
+        mass: kg.
+        mu: friction coefficient.
+        use_clp: solve every LP with CLP alone.
     """
 
     def __init__(self, mass: float, mu: float = FRICTION, use_clp: bool = False):
-        hpp = _import_hpp_centroidal_dynamics()
-        self._hpp = hpp
-        solver = hpp.SolverLP.SOLVER_LP_CLP if use_clp else hpp.SolverLP.SOLVER_LP_QPOASES
+        self._hpp = _import_hpp_centroidal_dynamics()
         self.mass = float(mass)
         self.mu = float(mu)
-        self._eq = hpp.Equilibrium("talos", self.mass, GENERATORS_PER_CONTACT, solver)
+        self.use_clp = use_clp
+        self._eq = self._new_equilibrium(use_clp)
+        self._contacts = None  # (points [N, 3], normals [N, 3]) set on self._eq
         self._contacts_key = None
+        self._clp = None  # CLP Equilibrium for the LPs qpOASES fails on
+        self._clp_key = None  # key of the contact set on self._clp
+
+    def _new_equilibrium(self, clp: bool):
+        """A hpp-centroidal-dynamics Equilibrium of this mass solving its LPs with CLP or qpOASES."""
+        solvers = self._hpp.SolverLP
+        solver = solvers.SOLVER_LP_CLP if clp else solvers.SOLVER_LP_QPOASES
+        return self._hpp.Equilibrium("talos", self.mass, GENERATORS_PER_CONTACT, solver)
+
+    def _load_contacts(self, equilibrium, points: np.ndarray, normals: np.ndarray) -> None:
+        """Give `equilibrium` the contact set (points, normals) for the LP algorithm."""
+        algorithm = self._hpp.EquilibriumAlgorithm.EQUILIBRIUM_ALGORITHM_LP
+        if not equilibrium.setNewContacts(points, normals, self.mu, algorithm):
+            raise RuntimeError("hpp-centroidal-dynamics rejected the contact set")
 
     def set_contacts(self, points: np.ndarray, normals: np.ndarray) -> None:
         """Set contact points [N, 3] and unit normals [N, 3], world frame."""
@@ -130,18 +159,33 @@ class HppEquilibrium:
         key = (points.tobytes(), normals.tobytes())
         if key == self._contacts_key:
             return
-        if not self._eq.setNewContacts(
-            points, normals, self.mu, self._hpp.EquilibriumAlgorithm.EQUILIBRIUM_ALGORITHM_LP
-        ):
-            raise RuntimeError("hpp-centroidal-dynamics rejected the contact set")
+        self._load_contacts(self._eq, points, normals)
+        self._contacts = (points, normals)
         self._contacts_key = key
 
+    def _clp_equilibrium(self):
+        """The CLP Equilibrium holding the current contact set (made and loaded on demand)."""
+        if self._clp is None:
+            self._clp = self._new_equilibrium(clp=True)
+        if self._clp_key != self._contacts_key:
+            self._load_contacts(self._clp, *self._contacts)
+            self._clp_key = self._contacts_key
+        return self._clp
+
     def robustness(self, com: np.ndarray) -> float:
-        """Robustness of the current contact set for a CoM [3] (world); -inf if the LP fails."""
-        status, value = self._eq.computeEquilibriumRobustness(np.asarray(com, dtype=np.float64))
-        if status != self._hpp.LP_status.LP_STATUS_OPTIMAL:
-            return -np.inf
-        return float(value)
+        """Robustness of the current contact set for a CoM [3] (world); -inf if the LP has no optimum.
+
+        Raises:
+            RuntimeError: no contact set yet (`set_contacts`).
+        """
+        if self._contacts is None:
+            raise RuntimeError("no contact set: call set_contacts first")
+        com = np.asarray(com, dtype=np.float64)
+        optimal = self._hpp.LP_status.LP_STATUS_OPTIMAL
+        status, value = self._eq.computeEquilibriumRobustness(com)
+        if status != optimal and not self.use_clp:
+            status, value = self._clp_equilibrium().computeEquilibriumRobustness(com)
+        return float(value) if status == optimal else -np.inf
 
     def feet_robustness(self, feet: np.ndarray, com: np.ndarray) -> float:
         """Robustness of a stance: feet [F, 7] (NaN rows in the air), CoM [3], world."""

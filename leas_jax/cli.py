@@ -60,6 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
     from leas_jax import pipeline
     from leas_jax.contacts import commands as contacts_commands
     from leas_jax.eval import commands as eval_commands
+    from leas_jax.feasibility import commands as feasibility_commands
     from leas_jax.motion import commands as motion_commands
     from leas_jax.navigate import commands as navigate_commands
     from leas_jax.steering import commands as steering_commands
@@ -76,6 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
     eval_commands.register(sub)
     navigate_commands.register(sub)
     motion_commands.register(sub)
+    feasibility_commands.register(sub)
     return parser
 
 

@@ -4,8 +4,8 @@
     result = navigate(policy, terrain, start=(2.0, 4.0, 0.0), goal=(9.5, 5.0))
     result.plan.save("plan.npz")              # passes `leas verify`
 
-Modules: lattice (the root's valid set over positions x headings, jitted), search (Dijkstra
-over the lattice), loop (closed loop with the LeaS policy and the contact generator),
+Modules: lattice (the root's confident and doubtful poses over positions x headings, with a
+step model, jitted), search (A* over the lattice), loop (closed loop with the LeaS policy and the contact generator),
 result (NavigationResult), commands (`leas navigate`), report (a navigate query as a
 report section). Attributes are imported lazily so
 that `import leas_jax.navigate` (and the CLI's parser) loads no JAX.

@@ -48,7 +48,9 @@ def navigate_config(args):
     return dataclasses.replace(
         config,
         max_replans=args.max_replans,
-        lattice=dataclasses.replace(config.lattice, resolution=args.resolution),
+        lattice=dataclasses.replace(
+            config.lattice, resolution=args.resolution, offer_doubtful=not args.confident_only
+        ),
     )
 
 
@@ -165,4 +167,10 @@ def register(subparsers) -> None:
     )
     parser.add_argument("--max-replans", type=int, default=3, help="searches after the first (default 3)")
     parser.add_argument("--resolution", type=float, default=0.05, help="lattice cell size, m (default 0.05)")
+    parser.add_argument(
+        "--confident-only",
+        action="store_true",
+        help="search only ground the reachability condition accepts (default: also doubtful ground, "
+        "tilted tiles, blocks and stair edges, at a cost, judged by the contact generator)",
+    )
     parser.set_defaults(func=cmd_navigate)

@@ -26,17 +26,12 @@ poses (one compiled shape for every terrain, memory bounded by the chunk).
 
 from __future__ import annotations
 
-import dataclasses
-import functools
 import math
 from dataclasses import dataclass
 
-import jax
-import jax.numpy as jnp
 import numpy as np
 
-from leas_jax.env import reachability
-from leas_jax.env.field import sample_nearest
+from leas_jax.feasibility.walkability import crack_filled_ground, judge_poses, relaxed_reachability
 
 # The 16-neighbourhood offsets (cells), counter-clockwise from +x: the lattice's headings.
 OFFSETS = np.array(
@@ -135,76 +130,6 @@ def heading_index(yaw) -> np.ndarray:
     return np.argmin(np.abs(diff), axis=-1)
 
 
-def relaxed_reachability(reach, config: LatticeConfig):
-    """The plausible nodes' condition: `reach` (a `ReachabilityConfig`) without its lookahead
-    legs (the step model bounds height changes instead) and, unless
-    `config.relaxed_foothold_spread` is set, without its sole-flatness term (the leg disks must
-    still touch solid ground)."""
-    spread = reach.foothold_spread
-    if spread is not None:
-        spread = (
-            None if config.relaxed_foothold_spread is None else max(spread, config.relaxed_foothold_spread)
-        )
-    return dataclasses.replace(reach, leg_forward=0.0, foothold_spread=spread)
-
-
-def _all_terms(field, pose: jax.Array, reach) -> jax.Array:
-    """`reachability.valid` as a chain of ands: the disabled terms' constant True fold away
-    (stacked, XLA spends seconds constant-folding them over a 65 536-pose chunk)."""
-    return functools.reduce(jnp.logical_and, reachability.terms(field, pose, reach).values())
-
-
-def crack_filled_ground(field, crack_width: float) -> np.ndarray:
-    """[nx, ny] bool over the field's grid: solid ground, or void narrower than `crack_width`
-    (m) between solid ground on both sides (host; a binary closing by a disk)."""
-    from scipy import ndimage
-
-    heights = np.asarray(field.heights)
-    solid = heights > float(field.void_height) + 1e-3
-    radius = int(round(0.5 * crack_width / float(field.resolution)))
-    if radius < 1:
-        return solid
-    di, dj = np.meshgrid(np.arange(-radius, radius + 1), np.arange(-radius, radius + 1), indexing="ij")
-    disk = di**2 + dj**2 <= radius**2
-    padded = np.pad(solid, radius, mode="edge")  # the grid's border is no edge of the ground
-    return solid | ndimage.binary_closing(padded, structure=disk)[radius:-radius, radius:-radius]
-
-
-@functools.partial(jax.jit, static_argnums=(3, 4, 5))
-def _judge(field, ground_ok: jax.Array, planar: jax.Array, nominal_root_height: float, confident, plausible):
-    """Root z and both verdicts of planar poses [M, 3] (x, y, yaw) -> (z [M], confident [M],
-    plausible [M]).
-
-    The root stands `nominal_root_height` above the highest solid ground within `leg_radius`
-    of it (`Heightfield.leg_max`), not above the point under it: a root over a crack between
-    rubble tiles stands at the tiles' height, where the generator's feet are. The ground under
-    it must be solid or a crack (`ground_ok` [nx, ny] bool, `crack_filled_ground`).
-    """
-    ground = sample_nearest(field, field.leg_max, planar[:, :2], outside=-jnp.inf)
-    solid = jnp.isfinite(ground) & sample_nearest(field, ground_ok, planar[:, :2], outside=False)
-    z = jnp.where(solid, ground, field.void_height) + nominal_root_height
-    poses = jnp.stack([planar[:, 0], planar[:, 1], z, planar[:, 2]], axis=1)
-    sure = jax.vmap(lambda pose: _all_terms(field, pose, confident))(poses) & solid
-    maybe = jax.vmap(lambda pose: _all_terms(field, pose, plausible))(poses) & solid
-    return z, sure, maybe
-
-
-def _check(
-    field, ground_ok, planar: np.ndarray, nominal_root_height: float, confident, plausible, chunk: int
-):
-    """`_judge` over planar poses [M, 3] (x, y, yaw), `chunk` poses per jitted call (one
-    compiled shape). -> (root z [M] float, confident [M] bool, plausible [M] bool)."""
-    out = np.zeros((3, len(planar)))
-    for begin in range(0, len(planar), chunk):
-        part = planar[begin : begin + chunk]
-        if len(part) < chunk:  # pad: every call has the same shape (one compile)
-            part = np.concatenate([part, np.repeat(part[-1:], chunk - len(part), axis=0)])
-        n = min(chunk, len(planar) - begin)
-        judged = _judge(field, ground_ok, jnp.asarray(part), float(nominal_root_height), confident, plausible)
-        out[:, begin : begin + n] = np.stack([np.asarray(a, np.float64)[:n] for a in judged])
-    return out[0], out[1] > 0.5, out[2] > 0.5
-
-
 def _shifted(grid: np.ndarray, dx: int, dy: int, fill) -> np.ndarray:
     """grid[i + dx, j + dy, ...] at each (i, j) of grid [nx, ny, ...], `fill` off the grid."""
     nx, ny = grid.shape[:2]
@@ -256,9 +181,13 @@ def build_lattice(
             np.column_stack([middles.reshape(-1, 2), yaw.reshape(-1)]),
         ]
     ).astype(np.float32)
-    plausible = relaxed_reachability(reach, config) if config.offer_doubtful else reach
-    ground_ok = jnp.asarray(crack_filled_ground(field, config.crack_width))
-    z, confident, ok = _check(field, ground_ok, planar, nominal_root_height, reach, plausible, config.chunk)
+    plausible = (
+        relaxed_reachability(reach, config.relaxed_foothold_spread) if config.offer_doubtful else reach
+    )
+    ground_ok = crack_filled_ground(field, config.crack_width)
+    z, confident, ok = judge_poses(
+        field, ground_ok, planar, nominal_root_height, reach, plausible, None, config.chunk
+    )
     ok |= confident
     count = nx * ny * 16
     node_valid = ok[:count].reshape(nx, ny, 16)

@@ -38,7 +38,7 @@ import numpy as np
 from leas_jax.contacts.planner.config import GeneratorConfig
 from leas_jax.errors import UsageError
 from leas_jax.navigate import result as reasons
-from leas_jax.navigate.lattice import LatticeConfig, build_lattice
+from leas_jax.navigate.lattice import LatticeConfig, build_lattice, relaxed_reachability
 from leas_jax.navigate.result import Attempt, NavigationResult
 from leas_jax.navigate.search import SearchConfig, SearchResult, graph, search
 
@@ -200,16 +200,26 @@ class Navigator:
             )
         return Query(np.asarray(pose, np.float64), float(speed), route)
 
+    def _start_condition(self):
+        """The condition a start must pass: the lattice's plausible set where it offers doubtful
+        ground (the generator judges the rest), else the env's reachability condition."""
+        lattice = self.config.lattice
+        if not lattice.offer_doubtful:
+            return self.env.reachability
+        return relaxed_reachability(self.env.reachability, lattice.relaxed_foothold_spread)
+
     def _failing_terms(self, pose) -> list[str]:
-        """Names of the parts of the condition a pose [4] fails (solid_ground: the void under it)."""
+        """Names of the parts of the start condition a pose [4] fails (solid_ground: the void
+        under it)."""
         import jax.numpy as jnp
 
         from leas_jax.steering.baselines import lift_checked
 
-        parts = _jitted_terms()(self.field, jnp.asarray(pose, jnp.float32), self.env.reachability)
+        condition = self._start_condition()
+        parts = _jitted_terms()(self.field, jnp.asarray(pose, jnp.float32), condition)
         failing = [k for k, v in parts.items() if not bool(v)]
         _, ok = lift_checked(
-            self.field, np.asarray(pose)[None, [0, 1, 3]], self.env.nominal_root_height, self.env.reachability
+            self.field, np.asarray(pose)[None, [0, 1, 3]], self.env.nominal_root_height, condition
         )
         if not ok[0] and not failing:
             failing = ["solid_ground"]

@@ -1,0 +1,472 @@
+"""The walkability model: which root poses on rough ground the contact generator walks from.
+
+The global layer of `leas navigate` (`leas_jax.navigate.lattice`) judges root poses standing
+`nominal_root_height` above the ground (the highest solid ground within the leg radius; void
+narrower than a crack counts as ground). A pose is *plausible* when the reachability cylinders
+without their sole-flatness and lookahead terms accept it (trunk, leg reach, hands, solid
+ground): no contact plan passes without those. Among plausible poses, the walkability model
+says which the generator walks from (its walking truth: it covers the 0.36 m straight guide
+ahead, `walking_truth`): the learned condition's network (`leas_jax.env.learned_feasibility`:
+root-frame height patch, height above the local ground, the cylinders' margins), fitted on
+poses of procedural terrain families (`families`) labelled by the generator, its threshold
+set for `target_sensitivity` on a share of them kept aside.
+
+Everything here is host code around jitted pieces (`judge` is jitted and vmapped):
+  - `relaxed_reachability`, `crack_filled_ground`, `judge`, `judge_poses`: the plausible set
+    and the model's verdicts, shared with the lattice;
+  - `family_poses`, `walking_labels`: data (labels cached on disk under a key of the terrain
+    text, the generator's settings and code; resumable);
+  - `build`: data, fit and report in one call (`leas walkability`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import multiprocessing
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from leas_jax.env import reachability
+from leas_jax.env.field import sample_nearest
+from leas_jax.feasibility.families import FAMILIES, FEATURE_X, family_terrain
+from leas_jax.feasibility.label_cache import cached_labels
+from leas_jax.feasibility.walking_truth import WALK_TIMESTEP, dataset_key, walking_guide
+
+WEIGHTS = "checkpoints/walkability/walkability.npz"  # the shipped model (relative to the repository)
+HELD_OUT = ("blocks", "stones")  # families kept out of the fit: the report's generalisation test
+
+
+@dataclass(frozen=True)
+class WalkabilityConfig:
+    """Data, fit and split of the walkability model."""
+
+    train_families: tuple = tuple(f for f in FAMILIES if f not in HELD_OUT)
+    held_out_families: tuple = HELD_OUT
+    terrains_per_family: int = 6  # seeds 0..n-1 fit (training families); seeds 100.. test
+    test_terrains_per_family: int = 3
+    poses_per_terrain: int = 300  # plausible poses drawn per terrain (before labelling)
+    feature_fraction: float = 0.8  # share of poses drawn over the feature's x band (+-0.5 m)
+    target_sensitivity: float = 0.95  # the threshold keeps this share of walkable poses
+    nominal_root_height: float = 1.0  # m above the ground (EnvConfig.nominal_root_height)
+    crack_width: float = 0.10  # m, `crack_filled_ground`
+    seed: int = 0
+
+
+def relaxed_reachability(reach, relaxed_foothold_spread: float | None = None):
+    """The plausible poses' condition: `reach` (a `ReachabilityConfig`) without its lookahead
+    legs (a step model bounds height changes instead) and, unless `relaxed_foothold_spread` is
+    given, without its sole-flatness term (the leg disks must still touch solid ground)."""
+    spread = reach.foothold_spread
+    if spread is not None:
+        spread = None if relaxed_foothold_spread is None else max(spread, relaxed_foothold_spread)
+    return dataclasses.replace(reach, leg_forward=0.0, foothold_spread=spread)
+
+
+def crack_filled_ground(field, crack_width: float) -> np.ndarray:
+    """[nx, ny] bool over the field's grid: solid ground, or void narrower than `crack_width`
+    (m) between solid ground on both sides (host; a binary closing by a disk, so a platform's
+    edge stays an edge)."""
+    from scipy import ndimage
+
+    heights = np.asarray(field.heights)
+    solid = heights > float(field.void_height) + 1e-3
+    radius = int(round(0.5 * crack_width / float(field.resolution)))
+    if radius < 1:
+        return solid
+    di, dj = np.meshgrid(np.arange(-radius, radius + 1), np.arange(-radius, radius + 1), indexing="ij")
+    disk = di**2 + dj**2 <= radius**2
+    padded = np.pad(solid, radius, mode="edge")  # the grid's border is no edge of the ground
+    return solid | ndimage.binary_closing(padded, structure=disk)[radius:-radius, radius:-radius]
+
+
+def _all_terms(field, pose: jax.Array, reach) -> jax.Array:
+    """`reachability.valid` as a chain of ands: the disabled terms' constant True fold away
+    (stacked, XLA spends seconds constant-folding them over a 65 536-pose chunk)."""
+    return functools.reduce(jnp.logical_and, reachability.terms(field, pose, reach).values())
+
+
+@functools.partial(jax.jit, static_argnums=(3, 4, 5))
+def judge(
+    field, ground_ok: jax.Array, planar: jax.Array, nominal_root_height: float, confident, plausible, model
+):
+    """Root z and both verdicts of planar poses [M, 3] (x, y, yaw), world.
+
+    The root stands `nominal_root_height` above the highest solid ground within `leg_radius`
+    of it (`Heightfield.leg_max`), not above the point under it: a root over a crack between
+    rubble tiles stands at the tiles' height, where the generator's feet are. The ground under
+    it must be solid or a crack (`ground_ok` [nx, ny] bool, `crack_filled_ground`).
+
+    Args:
+        field: the heightfield, with the rasters of `confident`.
+        ground_ok: [nx, ny] bool.
+        planar: [M, 3].
+        nominal_root_height: m.
+        confident: `ReachabilityConfig` of the confident verdict without a model (and of the
+            model's margins with one).
+        plausible: `ReachabilityConfig` of the plausible set (`relaxed_reachability`).
+        model: `LearnedParams` of the walkability model, or None (confident: the cylinders).
+
+    Returns:
+        (z [M], confident [M] bool, plausible [M] bool); confident implies plausible with a
+        model (the model only splits the plausible set).
+    """
+    from leas_jax.env import learned_feasibility as lf
+
+    ground = sample_nearest(field, field.leg_max, planar[:, :2], outside=-jnp.inf)
+    solid = jnp.isfinite(ground) & sample_nearest(field, ground_ok, planar[:, :2], outside=False)
+    z = jnp.where(solid, ground, field.void_height) + nominal_root_height
+    poses = jnp.stack([planar[:, 0], planar[:, 1], z, planar[:, 2]], axis=1)
+    maybe = jax.vmap(lambda pose: _all_terms(field, pose, plausible))(poses) & solid
+    if model is None:
+        sure = jax.vmap(lambda pose: _all_terms(field, pose, confident))(poses) & solid
+    else:
+        sure = maybe & (
+            jax.vmap(lambda pose: lf.logit(model, field, pose, confident))(poses) >= model["threshold"]
+        )
+    return z, sure, maybe
+
+
+def judge_poses(
+    field, ground_ok, planar: np.ndarray, nominal_root_height: float, confident, plausible, model, chunk: int
+):
+    """`judge` over planar poses [M, 3] (x, y, yaw), `chunk` poses per jitted call (one
+    compiled shape). -> (root z [M] float, confident [M] bool, plausible [M] bool)."""
+    out = np.zeros((3, len(planar)))
+    ground_ok = jnp.asarray(ground_ok)
+    for begin in range(0, len(planar), chunk):
+        part = planar[begin : begin + chunk]
+        if len(part) < chunk:  # pad: every call has the same shape (one compile)
+            part = np.concatenate([part, np.repeat(part[-1:], chunk - len(part), axis=0)])
+        n = min(chunk, len(planar) - begin)
+        judged = judge(
+            field,
+            ground_ok,
+            jnp.asarray(part, jnp.float32),
+            float(nominal_root_height),
+            confident,
+            plausible,
+            model,
+        )
+        out[:, begin : begin + n] = np.stack([np.asarray(a, np.float64)[:n] for a in judged])
+    return out[0], out[1] > 0.5, out[2] > 0.5
+
+
+# ---- data ------------------------------------------------------------------------------------
+
+
+def _field(terrain):
+    """The heightfield of a terrain with the calibrated cylinders' rasters (the model's margins)."""
+    from leas_jax.env import EnvConfig, heightfield_from_terrain
+
+    return heightfield_from_terrain(terrain, EnvConfig(condition="cylinders"))
+
+
+def plausible_poses(terrain, count: int, seed: int, config: WalkabilityConfig, band=FEATURE_X) -> np.ndarray:
+    """[k <= count, 4] (x, y, z, yaw) plausible poses on a terrain, seeded: x over `band` +- 0.5 m
+    for `feature_fraction` of the draws (None: all over the terrain), the rest anywhere 0.3 m
+    inside the bounds; yaw uniform; z as the lattice sets it (`judge`)."""
+    from leas_jax.env.config import ReachabilityConfig
+
+    rng = np.random.default_rng(seed)
+    (x0, y0), (x1, y1) = np.asarray(terrain.bounds) + np.array([[0.3, 0.3], [-0.3, -0.3]])
+    near = 0 if band is None else int(round(config.feature_fraction * count))
+    xs = np.concatenate(
+        [
+            rng.uniform(max(x0, band[0] - 0.5), min(x1, band[1] + 0.5), near) if near else np.zeros(0),
+            rng.uniform(x0, x1, count - near),
+        ]
+    )
+    planar = np.column_stack([xs, rng.uniform(y0, y1, count), rng.uniform(-np.pi, np.pi, count)])
+    field = _field(terrain)
+    reach = ReachabilityConfig()
+    z, _, maybe = judge_poses(
+        field,
+        crack_filled_ground(field, config.crack_width),
+        planar,
+        config.nominal_root_height,
+        reach,
+        relaxed_reachability(reach),
+        None,
+        chunk=1024,
+    )
+    return np.column_stack([planar[:, :2], z, planar[:, 2]])[maybe]
+
+
+_WORKER = {}
+
+
+def _init_worker(terrain_text: str, generator_config) -> None:
+    from leas_jax.contacts.planner.generator import ContactGenerator
+    from leas_jax.terrain import loads_terrain
+
+    _WORKER["generator"] = ContactGenerator(
+        loads_terrain(terrain_text, source="<walkability>"), generator_config
+    )
+
+
+def _walk(poses: np.ndarray) -> np.ndarray:
+    generator = _WORKER["generator"]
+    return np.array([generator.plan(walking_guide(p), WALK_TIMESTEP).coverage >= 1.0 for p in poses], bool)
+
+
+def walking_labels(
+    terrain, poses: np.ndarray, cache: Path, workers: int, generator_config=None
+) -> np.ndarray:
+    """The generator's walking truth at poses [N, 4] (bool [N]); cached in `cache` under the
+    data key of the terrain text, generator settings and code (resumable chunk by chunk).
+    `workers` > 1: spawned processes, one ContactGenerator each."""
+    from leas_jax.contacts.planner.generator import GeneratorConfig
+
+    generator_config = GeneratorConfig() if generator_config is None else generator_config
+    key = dataset_key(terrain.text, generator_config)
+    path = Path(cache) / f"walkability_{key[:16]}_{len(poses)}.npz"
+    chunk = 25
+    if workers <= 1:
+        _init_worker(terrain.text, generator_config)
+        return cached_labels(poses, key, path, lambda chunks: map(_walk, chunks), chunk)
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(workers, initializer=_init_worker, initargs=(terrain.text, generator_config)) as pool:
+        return cached_labels(poses, key, path, lambda chunks: pool.imap(_walk, chunks), chunk)
+
+
+@dataclass
+class LabelledSet:
+    """Poses with their features and the generator's verdicts, from several terrains.
+
+    Attributes:
+        x: [N, F] raw features (`learned_feasibility.features`).
+        y: [N] bool, walkable (walking truth).
+        cylinders: [N] bool, the calibrated cylinders' verdict (the confident set without a model).
+        group: [N] str, the family or scene each pose comes from.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    cylinders: np.ndarray
+    group: np.ndarray
+
+
+def labelled_terrain(
+    terrain, group: str, count: int, seed: int, config, cache, workers, grid_params, band=FEATURE_X
+):
+    """`LabelledSet` of `count` draws of plausible poses on one terrain."""
+    from leas_jax.env import reachability as cyl
+    from leas_jax.env.config import ReachabilityConfig
+    from leas_jax.feasibility.fit import features_of
+
+    poses = plausible_poses(terrain, count, seed, config, band)
+    field = _field(terrain)
+    reach = ReachabilityConfig()
+    labels = walking_labels(terrain, poses, cache, workers)
+    valid = np.asarray(
+        jax.jit(jax.vmap(lambda p: cyl.valid(field, p, reach)))(jnp.asarray(poses, jnp.float32))
+    )
+    x = features_of(grid_params, field, poses, reach)
+    return LabelledSet(x, labels, valid.astype(bool), np.full(len(poses), group))
+
+
+def concatenate(sets) -> LabelledSet:
+    """One `LabelledSet` of several."""
+    return LabelledSet(
+        *(np.concatenate([getattr(s, f.name) for s in sets]) for f in dataclasses.fields(LabelledSet))
+    )
+
+
+def rates(predicted: np.ndarray, y: np.ndarray) -> dict:
+    """Sensitivity and specificity of verdicts [N] against labels [N], with 95 % Wilson intervals."""
+    from leas_jax.stats import wilson
+
+    predicted, y = np.asarray(predicted, bool), np.asarray(y, bool)
+    tp, pos = int((predicted & y).sum()), int(y.sum())
+    tn, neg = int((~predicted & ~y).sum()), int((~y).sum())
+    return {
+        "walkable": pos,
+        "not_walkable": neg,
+        "sensitivity": tp / pos if pos else float("nan"),
+        "sensitivity_ci": list(wilson(tp, pos)),
+        "specificity": tn / neg if neg else float("nan"),
+        "specificity_ci": list(wilson(tn, neg)),
+    }
+
+
+def family_sets(families, seeds, config, cache, workers, grid_params, say) -> list[LabelledSet]:
+    """A `LabelledSet` per (family, seed) terrain."""
+    from leas_jax.terrain import loads_terrain
+
+    out = []
+    for family in families:
+        for seed in seeds:
+            began = time.perf_counter()
+            terrain = loads_terrain(family_terrain(family, seed), source=f"<family {family} {seed}>")
+            part = labelled_terrain(
+                terrain,
+                family,
+                config.poses_per_terrain,
+                config.seed + seed,
+                config,
+                cache,
+                workers,
+                grid_params,
+            )
+            say(
+                f"{family} seed {seed}: {len(part.y)} plausible poses, {int(part.y.sum())} walkable "
+                f"({time.perf_counter() - began:.1f} s)"
+            )
+            out.append(part)
+    return out
+
+
+# ---- fit and report ----------------------------------------------------------------------------
+
+
+def data_key(config: WalkabilityConfig, scenes=()) -> str:
+    """sha256 (hex) of what a build's data depend on: every family terrain's and scene's text,
+    the generator's settings and code, and the config (`walking_truth.dataset_key`)."""
+    import hashlib
+
+    from leas_jax.contacts.planner.generator import GeneratorConfig
+
+    digest = hashlib.sha256(repr(config).encode())
+    seeds = list(range(config.terrains_per_family)) + [
+        100 + s for s in range(config.test_terrains_per_family)
+    ]
+    texts = [family_terrain(f, s) for f in (*config.train_families, *config.held_out_families) for s in seeds]
+    texts += [scene.text for scene in scenes]
+    for text in texts:
+        digest.update(dataset_key(text, GeneratorConfig()).encode())
+    return digest.hexdigest()
+
+
+def _row(name: str, model: dict, cylinders: dict) -> str:
+    def cell(r, key):
+        low, high = r[f"{key}_ci"]
+        return f"{100 * r[key]:.1f} [{100 * low:.1f}, {100 * high:.1f}]"
+
+    return (
+        f"| {name} | {model['walkable']} / {model['not_walkable']} | {cell(model, 'sensitivity')} | "
+        f"{cell(model, 'specificity')} | {cell(cylinders, 'sensitivity')} | {cell(cylinders, 'specificity')} |"
+    )
+
+
+def report_table(report: dict) -> str:
+    """Markdown table of a build's report: per split and group, the model's and the calibrated
+    cylinders' sensitivity and specificity (%, 95 % Wilson intervals)."""
+    lines = [
+        "| poses | walkable / not | model sensitivity | model specificity | cylinders sensitivity | "
+        "cylinders specificity |",
+        "|---|---|---|---|---|---|",
+    ]
+    for split, groups in report["splits"].items():
+        for group, r in groups.items():
+            lines.append(_row(f"{split}: {group}", r["model"], r["cylinders"]))
+    return "\n".join(lines) + "\n"
+
+
+def _split_report(part: LabelledSet, params) -> dict:
+    from leas_jax.feasibility.fit import predict
+
+    verdicts = predict(params, part.x)
+    groups = {"all": np.ones(len(part.y), bool)} | {
+        g: part.group == g for g in dict.fromkeys(part.group.tolist())
+    }
+    return {
+        name: {"model": rates(verdicts[m], part.y[m]), "cylinders": rates(part.cylinders[m], part.y[m])}
+        for name, m in groups.items()
+    }
+
+
+def build(
+    out: Path,
+    config: WalkabilityConfig = WalkabilityConfig(),
+    scenes=(),
+    cache: Path = Path(".cache"),
+    workers: int = 2,
+    say=print,
+) -> dict:
+    """Data, fit and report of the walkability model (host).
+
+    Labels the plausible poses of `terrains_per_family` seeds of each training family (the fit),
+    of `test_terrains_per_family` other seeds of every family (the test: training families on
+    unseen terrains, held-out families never seen), and of each scene (a `Terrain` with its own
+    bounds; poses anywhere on it); fits the network (`fit.fit`, threshold for
+    `target_sensitivity`), writes the weights to `out` (.npz, with the data key and settings)
+    and returns the report (also written beside them as walkability.json and walkability.md).
+    """
+    import json
+
+    from leas_jax.env import learned_feasibility as lf
+    from leas_jax.env.config import ReachabilityConfig
+    from leas_jax.feasibility.fit import FitConfig, fit
+    from leas_jax.files import atomic_write_text
+
+    began = time.perf_counter()
+    reach = ReachabilityConfig()
+    grid_params = lf.init_params(jax.random.PRNGKey(config.seed), reach=reach)
+    cache = Path(cache)
+    cache.mkdir(parents=True, exist_ok=True)
+    fit_seeds = range(config.terrains_per_family)
+    test_seeds = range(100, 100 + config.test_terrains_per_family)
+    train = concatenate(
+        family_sets(config.train_families, fit_seeds, config, cache, workers, grid_params, say)
+    )
+    seen = concatenate(
+        family_sets(config.train_families, test_seeds, config, cache, workers, grid_params, say)
+    )
+    held = concatenate(
+        family_sets(config.held_out_families, test_seeds, config, cache, workers, grid_params, say)
+    )
+    scene_sets = []
+    for k, scene in enumerate(scenes):
+        part = labelled_terrain(
+            scene,
+            scene.name,
+            2 * config.poses_per_terrain,
+            config.seed + 1000 + k,
+            config,
+            cache,
+            workers,
+            grid_params,
+            band=None,
+        )
+        say(f"{scene.name}: {len(part.y)} plausible poses, {int(part.y.sum())} walkable")
+        scene_sets.append(part)
+    fit_config = FitConfig(target_sensitivity=config.target_sensitivity, seed=config.seed)
+    params, info = fit(train.x, train.y, fit_config, reach=reach)
+    key = data_key(config, scenes)
+    lf.save_params(
+        out,
+        params,
+        data_key=key,
+        model="walkability",
+        families=json.dumps(
+            {"train": list(config.train_families), "held_out": list(config.held_out_families)}
+        ),
+        fit=json.dumps(dataclasses.asdict(fit_config)),
+        walkability=json.dumps(dataclasses.asdict(config)),
+        reachability=json.dumps(dataclasses.asdict(reach)),
+    )
+    splits = {
+        "fit": _split_report(train, params),
+        "unseen terrains of the training families": _split_report(seen, params),
+        "held-out families": _split_report(held, params),
+    }
+    if scene_sets:
+        splits["hpp-environments scenes"] = _split_report(concatenate(scene_sets), params)
+    report = {
+        "weights": str(out),
+        "data_key": key,
+        "config": dataclasses.asdict(config),
+        "fit": info,
+        "seconds": round(time.perf_counter() - began, 1),
+        "splits": splits,
+    }
+    folder = Path(out).parent
+    atomic_write_text(folder / "walkability.json", json.dumps(report, indent=1, default=float) + "\n")
+    atomic_write_text(folder / "walkability.md", report_table(report))
+    return report

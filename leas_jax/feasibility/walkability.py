@@ -426,7 +426,7 @@ def build(
         part = labelled_terrain(
             scene,
             scene.name,
-            2 * config.poses_per_terrain,
+            config.poses_per_terrain,
             config.seed + 1000 + k,
             config,
             cache,

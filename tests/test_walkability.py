@@ -1,0 +1,152 @@
+"""The walkability model: terrain families, the plausible set and the model's verdicts (shapes,
+jit), a known rule learned from synthetic labels, the label cache's invalidation, rates, and the
+`leas walkability` command's errors."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+
+import jax
+import numpy as np
+import pytest
+
+from leas_jax.env.config import ReachabilityConfig
+from leas_jax.feasibility import walkability as wk
+from leas_jax.feasibility.families import FAMILIES, family_terrain
+from leas_jax.terrain import loads_terrain
+
+CONFIG = wk.WalkabilityConfig()
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_every_family_draws_a_seeded_terrain_with_its_feature(family):
+    first, again, other = (family_terrain(family, s) for s in (0, 0, 1))
+    assert first == again and first != other
+    terrain = loads_terrain(first)
+    heights = terrain.raster()
+    res = terrain.resolution
+    before = heights[int(0.5 / res) : int(1.5 / res)]  # flat ground at z = 0 before the feature
+    assert np.allclose(before, 0.0, atol=1e-6)
+    feature = heights[int(2.1 / res) : int(4.3 / res)]
+    assert np.ptp(feature) > 0.03, "the feature is not flat ground"
+
+
+def test_an_unknown_family_names_the_known_ones():
+    with pytest.raises(ValueError, match="unknown terrain family 'lava'.*rubble, blocks"):
+        family_terrain("lava", 0)
+
+
+def test_the_plausible_condition_drops_the_lookahead_and_the_sole_flatness():
+    reach = ReachabilityConfig()
+    relaxed = wk.relaxed_reachability(reach)
+    assert relaxed.leg_forward == 0.0 and relaxed.foothold_spread is None
+    assert relaxed.trunk_bottom == reach.trunk_bottom and relaxed.hand_radius == reach.hand_radius
+    assert wk.relaxed_reachability(reach, 0.12).foothold_spread == 0.12
+
+
+def _field(text):
+    terrain = loads_terrain(text)
+    return terrain, wk._field(terrain)
+
+
+def test_judge_gives_root_heights_and_a_model_only_splits_the_plausible_set():
+    from leas_jax.env import learned_feasibility as lf
+
+    terrain, field = _field(family_terrain("rubble", 0))
+    rng = np.random.default_rng(0)
+    planar = np.column_stack(
+        [rng.uniform(0.5, 5.5, 300), rng.uniform(0.5, 2.5, 300), rng.uniform(-3, 3, 300)]
+    )
+    ground = wk.crack_filled_ground(field, CONFIG.crack_width)
+    reach = ReachabilityConfig()
+    plausible = wk.relaxed_reachability(reach)
+    z, sure, maybe = wk.judge_poses(field, ground, planar, 1.0, reach, plausible, None, chunk=128)
+    assert z.shape == sure.shape == maybe.shape == (300,)
+    assert np.all(maybe[sure]), "a confident pose is plausible"
+    flat = planar[:, 0] < 1.8
+    assert np.allclose(z[flat], 1.0, atol=1e-5) and maybe[flat].all()
+    assert (maybe & ~sure)[~flat].any(), "the tiles hold doubtful poses"
+    model = lf.init_params(jax.random.PRNGKey(0), reach=reach)
+    for threshold, expect in ((-np.inf, maybe), (np.inf, np.zeros(300, bool))):
+        model["threshold"] = jax.numpy.asarray(threshold, jax.numpy.float32)
+        _, judged, again = wk.judge_poses(field, ground, planar, 1.0, reach, plausible, model, chunk=128)
+        assert np.array_equal(judged, expect) and np.array_equal(again, maybe)
+
+
+def test_a_known_rule_is_learned_from_synthetic_labels():
+    """Walkable iff the ground 0.25-0.6 m ahead rises 5 cm above the ground under the root: a rule
+    on the patch features alone, which the fit must recover on terrains it did not see."""
+    from leas_jax.env import learned_feasibility as lf
+    from leas_jax.feasibility.fit import FitConfig, features_of, fit, predict
+
+    reach = ReachabilityConfig()
+    params = lf.init_params(jax.random.PRNGKey(0), reach=reach)
+    grid = np.asarray(params["grid"])
+    ahead = (grid[:, 0] > 0.25) & (grid[:, 0] < 0.6) & (np.abs(grid[:, 1]) < 0.2)
+
+    def labelled(family, seed):
+        terrain, field = _field(family_terrain(family, seed))
+        poses = wk.plausible_poses(terrain, 400, seed, CONFIG)
+        x = features_of(params, field, poses, reach)
+        return x, x[:, : len(grid)][:, ahead].max(axis=1) > -CONFIG.nominal_root_height + 0.05
+
+    parts = [labelled(f, s) for f in ("stairs", "blocks", "clutter") for s in (0, 1)]
+    x, y = (np.concatenate(a) for a in zip(*parts))
+    assert 0.1 < y.mean() < 0.9
+    model, _ = fit(x, y, FitConfig(steps=400, mirror=False, target_sensitivity=0.95))
+    tx, ty = labelled("stairs", 7)
+    accuracy = (predict(model, tx) == ty).mean()
+    assert accuracy > 0.9, accuracy
+
+
+def test_rates_count_and_bound_both_classes():
+    r = wk.rates(np.array([1, 1, 0, 0, 1], bool), np.array([1, 1, 1, 0, 0], bool))
+    assert (r["walkable"], r["not_walkable"]) == (3, 2)
+    assert r["sensitivity"] == pytest.approx(2 / 3) and r["specificity"] == pytest.approx(0.5)
+    low, high = r["sensitivity_ci"]
+    assert low < 2 / 3 < high
+
+
+def test_walking_labels_are_cached_and_rebuilt_when_the_generator_changes(tmp_path, monkeypatch):
+    from leas_jax.contacts.planner.config import GeneratorConfig
+
+    terrain = loads_terrain(family_terrain("gaps", 0))
+    poses = np.array([[1.0, 1.5, 1.0, 0.0], [1.0, 1.0, 1.0, 0.3], [5.0, 1.5, 1.0, 3.1]])
+    first = wk.walking_labels(terrain, poses, tmp_path, workers=0)
+    assert first.all(), "flat ground is walkable"
+
+    def refuse(chunk):
+        raise AssertionError("the cache holds these labels")
+
+    monkeypatch.setattr(wk, "_walk", refuse)
+    assert np.array_equal(wk.walking_labels(terrain, poses, tmp_path, workers=0), first)
+    monkeypatch.setattr(wk, "_walk", lambda chunk: np.zeros(len(chunk), bool))
+    other = dataclasses.replace(GeneratorConfig(), lookahead=0.6)
+    assert not wk.walking_labels(terrain, poses, tmp_path, workers=0, generator_config=other).any()
+    moved = loads_terrain(family_terrain("gaps", 1))  # another terrain text: another key
+    assert not wk.walking_labels(moved, poses, tmp_path, workers=0).any()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--out", "w.txt"], "--out: expected a .npz file"),
+        (["--held-out", "lava"], "--held-out: unknown families lava"),
+        (["--scenes", "no/such/*.toml"], "--scenes: 'no/such/\\*.toml' matches no file"),
+        (["--poses-per-terrain", "0"], "--poses-per-terrain"),
+    ],
+)
+def test_walkability_command_errors_are_one_line(args, message, tmp_path):
+    import re
+
+    run = subprocess.run(
+        [sys.executable, "-m", "leas_jax.cli", "walkability", *args],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert run.returncode == 2
+    lines = [line for line in run.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and re.search(message, lines[0]), run.stderr

@@ -233,3 +233,44 @@ def test_doubtful_ground_is_refused_when_the_generator_does_not(policy):
     assert result.replans == 2 and all(a.failure is not None for a in result.attempts)
     assert result.plan.q[:, 0].max() <= ROUGH_X[0], "no verified posture on the tiles"
     assert "after 2 replans" in result.message
+
+
+def _saved_model(tmp_path, threshold: float, reach=None) -> str:
+    import dataclasses
+    import json
+
+    import jax
+
+    from leas_jax.env import learned_feasibility as lf
+    from leas_jax.env.config import ReachabilityConfig
+
+    reach = ReachabilityConfig() if reach is None else reach
+    params = lf.init_params(jax.random.PRNGKey(0), reach=ReachabilityConfig())
+    params["threshold"] = jax.numpy.asarray(threshold, jax.numpy.float32)
+    path = tmp_path / f"walkability_{threshold}.npz"
+    lf.save_params(path, params, reachability=json.dumps(dataclasses.asdict(reach)))
+    return str(path)
+
+
+def test_a_walkability_model_decides_which_plausible_nodes_are_confident(policy, tmp_path):
+    terrain = loads_terrain(ROUGH_STRIP)
+    plain = _lattice(policy, terrain)
+    accept = _lattice(policy, terrain, walkability=_saved_model(tmp_path, -np.inf))
+    refuse = _lattice(policy, terrain, walkability=_saved_model(tmp_path, np.inf))
+    for lattice in (accept, refuse):
+        assert np.array_equal(lattice.node_valid, plain.node_valid), "the plausible set is the model's input"
+    assert not accept.doubtful.any()
+    assert np.array_equal(refuse.doubtful, refuse.node_valid)
+
+
+def test_a_walkability_model_of_other_cylinders_is_refused_naming_the_file(policy, tmp_path):
+    import dataclasses
+
+    from leas_jax.env.config import ReachabilityConfig
+    from leas_jax.errors import UsageError
+
+    other = _saved_model(tmp_path, 0.0, dataclasses.replace(ReachabilityConfig(), trunk_radius=0.4))
+    with pytest.raises(UsageError, match="walkability_0.0.npz: the walkability model reads the margins"):
+        _lattice(policy, loads_terrain(ROUGH_STRIP), walkability=other)
+    with pytest.raises(UsageError, match="missing.npz"):
+        _lattice(policy, loads_terrain(ROUGH_STRIP), walkability=str(tmp_path / "missing.npz"))

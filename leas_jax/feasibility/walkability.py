@@ -157,6 +157,34 @@ def judge_poses(
     return out[0], out[1] > 0.5, out[2] > 0.5
 
 
+def load_walkability(path, reach):
+    """The walkability model's `LearnedParams` from an .npz of `leas walkability` (a path as given
+    or relative to the repository).
+
+    Raises:
+        UsageError: the file cannot be read, or its model reads the margins of another
+            `ReachabilityConfig` than `reach` (the field's rasters).
+    """
+    import json
+
+    from leas_jax.env.learned_weights import load_params
+    from leas_jax.errors import UsageError
+    from leas_jax.files import resolve_data_path
+
+    resolved = resolve_data_path(path)
+    try:
+        params, metadata = load_params(resolved)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    fitted = metadata.get("reachability")
+    if fitted is not None and json.loads(fitted) != dataclasses.asdict(reach):
+        raise UsageError(
+            f"{resolved}: the walkability model reads the margins of another ReachabilityConfig "
+            f"({fitted}) than the policy's env"
+        )
+    return params
+
+
 # ---- data ------------------------------------------------------------------------------------
 
 

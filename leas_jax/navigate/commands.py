@@ -41,15 +41,18 @@ def navigate_config(args):
     from leas_jax.navigate.loop import NavigateConfig
 
     config = NavigateConfig()
-    if args.max_replans < 0:
+    if args.max_replans is not None and args.max_replans < 0:
         raise UsageError(f"--max-replans: expected an integer >= 0, got {args.max_replans}")
     if not args.resolution > 0:
         raise UsageError(f"--resolution: expected a positive number of metres, got {args.resolution}")
     return dataclasses.replace(
         config,
-        max_replans=args.max_replans,
+        max_replans=config.max_replans if args.max_replans is None else args.max_replans,
         lattice=dataclasses.replace(
-            config.lattice, resolution=args.resolution, offer_doubtful=not args.confident_only
+            config.lattice,
+            resolution=args.resolution,
+            offer_doubtful=not args.confident_only,
+            walkability=args.walkability,
         ),
     )
 
@@ -165,8 +168,17 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--workers", type=int, default=1, help="contact-generator processes (0: in this process; default 1)"
     )
-    parser.add_argument("--max-replans", type=int, default=3, help="searches after the first (default 3)")
+    parser.add_argument(
+        "--max-replans", type=int, default=None, help="searches after the first (default 5, NavigateConfig)"
+    )
     parser.add_argument("--resolution", type=float, default=0.05, help="lattice cell size, m (default 0.05)")
+    parser.add_argument(
+        "--walkability",
+        metavar="WEIGHTS.npz",
+        default=None,
+        help="the walkability model (`leas walkability`) judges which plausible ground is confident "
+        "(default: the policy's reachability condition)",
+    )
     parser.add_argument(
         "--confident-only",
         action="store_true",

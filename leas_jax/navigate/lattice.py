@@ -31,7 +31,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from leas_jax.feasibility.walkability import crack_filled_ground, judge_poses, relaxed_reachability
+from leas_jax.feasibility.walkability import (
+    crack_filled_ground,
+    judge_poses,
+    load_walkability,
+    relaxed_reachability,
+)
 
 # The 16-neighbourhood offsets (cells), counter-clockwise from +x: the lattice's headings.
 OFFSETS = np.array(
@@ -75,6 +80,10 @@ class LatticeConfig:
     # over the strip. The edge of a platform stays an edge (a morphological closing of the
     # solid ground, which fills strips bounded on both sides only).
     crack_width: float = 0.10
+    # The walkability model's weights (`leas walkability`), or None: the confident verdict is
+    # then the env's reachability condition. With a model, a plausible pose is confident where
+    # the model accepts it.
+    walkability: str | None = None
 
 
 @dataclass(frozen=True)
@@ -185,8 +194,9 @@ def build_lattice(
         relaxed_reachability(reach, config.relaxed_foothold_spread) if config.offer_doubtful else reach
     )
     ground_ok = crack_filled_ground(field, config.crack_width)
+    model = None if config.walkability is None else load_walkability(config.walkability, reach)
     z, confident, ok = judge_poses(
-        field, ground_ok, planar, nominal_root_height, reach, plausible, None, config.chunk
+        field, ground_ok, planar, nominal_root_height, reach, plausible, model, config.chunk
     )
     ok |= confident
     count = nx * ny * 16

@@ -49,7 +49,10 @@ class NavigateConfig:
 
     lattice: LatticeConfig = LatticeConfig()
     search: SearchConfig = SearchConfig()
-    max_replans: int = 3  # searches after the first one
+    # searches after the first one. 5: on the HPP rough scenes (20 starts each,
+    # docs/results/2026-12-06-rough-scenes) every query that failed with 3 had used all 3 (the
+    # generator stops on rubble, another way round is tried); a query that reaches needs 0-2.
+    max_replans: int = 5
     # extra cost per m (on top of 1) of moving within failure_radius of a failure: 4 makes a
     # detour up to 5 x the length of the penalised stretch cheaper than going through again
     failure_penalty: float = 4.0

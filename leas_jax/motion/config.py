@@ -34,6 +34,20 @@ class MotionConfig:
     # foot's straight path and above both end placements, m (the plan's single-support
     # postures lift the foot 5-15 cm).
     swing_clearance: float = 0.05
+    # Single support where the swing sole cannot reach its contact from the one-foot
+    # posture's root (the plan stretches its legs to within a millimetre of their reach,
+    # knees at 0.05 rad, on steps): towards the contact the root moves `lean` m towards it
+    # along the stance sole (0.20 m long: the CoM stays over it; on eval_stairs this keeps
+    # the front shin off the next step's nosing at lift-off) and comes down until both knees
+    # are bent by `min_knee`, rad (a straight knee is the IK's singular point; measured on
+    # eval_stairs: 0.05 rad drives the swing knee past its 7 rad/s limit at lift-off).
+    lean: float = 0.015
+    min_knee: float = 0.3
+    # Single support lasts longer than lift_duration or land_duration where the CoM moves
+    # far (the root comes down and up on steps): its peak acceleration along the
+    # minimum-jerk move stays under this, m/s^2 (on eval_stairs a 0.11 m move in 0.6 s,
+    # 1.8 m/s^2, took the equilibrium robustness below 0).
+    single_support_acceleration: float = 0.5
     # Sole corners on the swing path may sink this far below the terrain surface, m (the
     # 5 mm contact tolerance of docs/design.md §6 check 1), except in the first and last
     # `contact_zone` of height above the contact plane, where the sole leaves or meets it.

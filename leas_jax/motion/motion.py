@@ -26,6 +26,7 @@ the URDF's effort limits.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import os
 from dataclasses import dataclass, field
@@ -62,6 +63,10 @@ MOTION_KEYS = (
     "dt",
 )
 PHASE_KINDS = ("shift", "lift", "land")
+# Single support: the root comes down at most this far, m, for the swing sole to reach its
+# contact (`single_support_coms`), found by steps of DIP_SCAN, m.
+MAX_DIP = 0.30
+DIP_SCAN = 0.01
 
 
 class MotionError(LeasError):
@@ -258,7 +263,9 @@ class _PhaseSpec:
         com0, com1: [3] CoM at the start and end.
         rot0, rot1: [3, 3] root orientation at the start and end.
         upper0, upper1: [39] configurations whose upper-body joints are used.
-        control: [P, 3] Bezier control points of the swing sole's path (empty in a shift).
+        apex: m, height of the swing sole's path (`paths.swing_path`; NaN in a shift).
+        coms: [samples, 3] CoM references of samples 1..n (single support), or None: straight
+            from com0 to com1.
     """
 
     kind: str
@@ -273,7 +280,8 @@ class _PhaseSpec:
     rot1: np.ndarray
     upper0: np.ndarray
     upper1: np.ndarray
-    control: np.ndarray
+    apex: float
+    coms: np.ndarray | None = None
 
 
 def _homogeneous(placement: np.ndarray) -> np.ndarray:
@@ -309,11 +317,11 @@ def _contacts(plan: ContactPlan, k: int) -> np.ndarray:
     return ~np.isnan(plan.feet[k, :, 0])
 
 
-def _apex(terrain, start: np.ndarray, end: np.ndarray, clearance: float) -> float:
-    """Height of a landing path's apex: `clearance` m above both ends and the terrain between.
+def _terrain_top(terrain, start: np.ndarray, end: np.ndarray) -> float:
+    """Highest terrain (m) under a sole moved straight from start [3] to end [3], world.
 
     The terrain is sampled under the sole rectangle (its corners and centre) at 21 points
-    along the straight segment from start [3] to end [3], world.
+    along the straight segment.
     """
     from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
 
@@ -321,20 +329,166 @@ def _apex(terrain, start: np.ndarray, end: np.ndarray, clearance: float) -> floa
     line = np.linspace(start[:2], end[:2], 21)
     offsets = np.array([[0.0, 0.0], [reach, 0.0], [-reach, 0.0], [0.0, reach], [0.0, -reach]])
     heights = terrain.height_at((line[:, None, :] + offsets[None]).reshape(-1, 2))
-    return float(max(start[2], end[2], heights.max()) + clearance)
+    return float(heights.max())
 
 
-def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig) -> list[_PhaseSpec]:
+def _apex(terrain, start: np.ndarray, end: np.ndarray, clearance: float) -> float:
+    """Height of a landing path's apex: `clearance` m above both ends [3] and the terrain between."""
+    return max(start[2], end[2], _terrain_top(terrain, start, end)) + clearance
+
+
+def held_root_configuration(
+    talos, q: np.ndarray, feet: np.ndarray, rotation: np.ndarray, offset: np.ndarray, knees: np.ndarray
+) -> np.ndarray | None:
+    """q [39] with its root moved by offset [3] (world, m) and turned to rotation [3, 3]
+    (world_R_base_link), both soles at feet [2, 4, 4] (world); or None.
+
+    The upper body stays as in q; each leg's six joints come from the analytic leg IK
+    (`contacts.robot.ik.leg_ik_single`). None when a leg cannot reach its sole, leaves its
+    joint limits, or bends its knee less than knees [2] (rad, left and right).
+    """
+    from leas_jax.contacts.robot.ik import leg_ik_single
+    from leas_jax.contacts.robot.model import quat_xyzw_from_matrix
+
+    out = np.array(q, dtype=np.float64)
+    out[:3] += offset
+    out[3:7] = quat_xyzw_from_matrix(rotation)
+    root = np.eye(4)
+    root[:3, :3] = rotation
+    root[:3, 3] = out[:3]
+    for side, leg in enumerate(talos.legs):
+        in_root = np.linalg.solve(root, feet[side])
+        joints = leg_ik_single(leg, in_root[:3, :3], in_root[:3, 3])
+        if joints is None or joints[3] < knees[side] - 1e-9:
+            return None
+        out[leg.q_index] = joints
+    return out
+
+
+def root_dip(
+    talos, q: np.ndarray, feet: np.ndarray, rotation: np.ndarray, shift: np.ndarray, knees: np.ndarray
+) -> float:
+    """Smallest lowering (m, within 1e-7) of q's root, moved horizontally by shift [2] and turned
+    to rotation [3, 3], for which `held_root_configuration` places both soles at feet [2, 4, 4];
+    NaN when none up to MAX_DIP does.
+
+    The lowerings that work form an interval (the legs reach from its low end and leave
+    their joint limits past its high end): a 1 cm scan finds it, bisection its low end.
+    """
+
+    def works(dip: float) -> bool:
+        return held_root_configuration(talos, q, feet, rotation, np.r_[shift, -dip], knees) is not None
+
+    if works(0.0):
+        return 0.0
+    scan = np.arange(1, round(MAX_DIP / DIP_SCAN) + 1) * DIP_SCAN
+    found = next((d for d in scan if works(d)), None)
+    if found is None:
+        return float("nan")
+    low, high = found - DIP_SCAN, found
+    while high - low > 1e-7:
+        middle = 0.5 * (low + high)
+        low, high = (low, middle) if works(middle) else (middle, high)
+    return high
+
+
+def contact_weight(samples: int, lifting: bool) -> np.ndarray:
+    """[samples] weight of a single-support phase's contact end: the minimum-jerk scaling s of
+    its normalised time (landing: s, its contact at the end) or 1 - s (lift: its contact at
+    the start); 0 at the key posture, with zero derivatives at both ends."""
+    from leas_jax.motion.paths import min_jerk
+
+    scaling = min_jerk(np.arange(samples) / (samples - 1))
+    return 1.0 - scaling if lifting else scaling
+
+
+def dip_depth(needs: np.ndarray, weight: np.ndarray) -> float:
+    """Smallest depth (m) with depth x weight [M] >= needs [M] (`root_dip`) at every sample;
+    0 when nothing needs lowering, inf when a sample of weight 0 (the key posture) does."""
+    if not (needs > 0.0).any():
+        return 0.0
+    positive = weight > 1e-12
+    if (needs[~positive] > 0.0).any():
+        return float("inf")
+    return float(np.max(needs[positive] / weight[positive]))
+
+
+def single_support_coms(
+    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+) -> np.ndarray:
+    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1.
+
+    q [39]: the phase's one-foot key posture; feet [M, 2, 4, 4]: the soles' references;
+    rotations [M, 3, 3]: the root's orientation references.
+
+    The root keeps the key posture's position where both legs reach their soles with their
+    knees bent by `config.min_knee` (or, at the key posture, by as much as it bends them,
+    and in between by a blend on `contact_weight`: the plan stretches its postures' legs
+    to within a millimetre of their reach, knees at 0.05 rad, on steps). Where they do
+    not, the root moves `config.lean` m along the stance sole (its x axis, horizontal)
+    towards the swing sole's contact (the sole is 0.20 m long, 0.13 m wide) and
+    comes down by the smallest depth that lets every sample's soles be reached, both
+    weighted by `contact_weight` (`held_root_configuration`, `root_dip`, `dip_depth`). The
+    CoM's height is that of those configurations; its horizontal position goes from the
+    first's to the last's on the minimum-jerk scaling (the root moves to make up for the
+    swing leg's mass, as in double support).
+
+    Raises:
+        MotionError: the soles are out of the legs' reach even MAX_DIP lower.
+    """
+    import pinocchio as pin
+
+    from leas_jax.motion.paths import lerp, min_jerk
+
+    weight = contact_weight(len(feet), lifting)
+    bent = np.array([q[leg.q_index[3]] for leg in talos.legs])
+    knees = config.min_knee - np.maximum(config.min_knee - bent, 0.0) * (1.0 - weight[:, None])  # [M, 2]
+    contact = feet[0 if lifting else -1]
+    ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
+    toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
+    shifts = np.zeros((len(feet), 2))
+    needs = np.array([root_dip(talos, q, *sample) for sample in zip(feet, rotations, shifts, knees)])
+    if (needs > 0.0).any():
+        shifts = config.lean * weight[:, None] * toward
+        needs = np.array([root_dip(talos, q, *sample) for sample in zip(feet, rotations, shifts, knees)])
+    if np.isnan(needs).any():
+        sample = int(np.flatnonzero(np.isnan(needs))[0])
+        raise MotionError(
+            f"at sample {sample} the soles are out of the legs' reach even with the root {MAX_DIP:g} m lower"
+        )
+    depth = dip_depth(needs, weight)
+    if not depth <= MAX_DIP:
+        raise MotionError(
+            f"the root would come down {depth:.3f} m (over {MAX_DIP:g} m) for the soles to reach"
+        )
+    data = talos.model.createData()
+    coms = np.empty((len(feet), 3))
+    for i, (f, shift) in enumerate(zip(feet, shifts)):
+        offset = np.r_[shift, -depth * weight[i]]
+        configuration = held_root_configuration(talos, q, f, rotations[i], offset, knees[i])
+        if configuration is None:
+            raise MotionError(f"at sample {i} the soles are out of the legs' reach with the root lowered")
+        coms[i] = pin.centerOfMass(talos.model, data, configuration, False)
+    coms[:, :2] = lerp(coms[0, :2], coms[-1, :2], min_jerk(np.arange(len(feet)) / (len(feet) - 1)))
+    return coms
+
+
+def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) -> list[_PhaseSpec]:
     """Phases from plan posture k to k + 1.
+
+    In single support the CoM follows `single_support_coms` (the root held at the one-foot
+    posture's placement, lowered where the swing sole needs it); the double-support shift
+    around it goes to or from that phase's CoM with the swing sole on the ground.
 
     Args:
         frames: list over postures of (feet [2, 4, 4], com [3], root rotation [3, 3]) by FK.
+        talos: `load_talos()` (the single-support CoMs).
 
     Raises:
         MotionError: the two postures differ in a way no phase sequence handles (both
             feet change, a foot moves while in contact, two single supports in a row).
     """
-    from leas_jax.motion.paths import landing_path, lift_path, shift_duration
+    from leas_jax.motion.paths import shift_duration
 
     feet_a, com_a, rot_a = frames[k]
     feet_b, com_b, rot_b = frames[k + 1]
@@ -348,7 +502,7 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig) -> list
         )
         return _PhaseSpec(
             "shift", (k, k + 1), -1, round(seconds / dt), feet, feet, com0, com1, rot0, rot1, upper0, upper1,
-            np.zeros((0, 3)),
+            float("nan"),
         )  # fmt: skip
 
     if on_a.all() and on_b.all():
@@ -362,57 +516,128 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig) -> list
         swing = int(np.flatnonzero(~on_b)[0])
         lifted = feet_a.copy()
         lifted[swing] = feet_b[swing]
-        control = lift_path(feet_a[swing][:3, 3], feet_b[swing][:3, 3])
+        start, end = feet_a[swing][:3, 3], feet_b[swing][:3, 3]
+        top = _terrain_top(terrain, start, end) + config.swing_clearance
+        apex = max(top, start[2], end[2])
+        lift = _PhaseSpec(
+            "lift", (k, k + 1), swing, round(config.lift_duration / dt), feet_a, lifted, com_b, com_b,
+            rot_a, rot_b, q_b, q_b, apex,
+        )  # fmt: skip
+        lift, coms = _single_support(talos, lift, k, config)
+        coms[-1] = com_b
         return [
-            shift(feet_a, com_a, com_b, rot_a, rot_b, q_a, q_b),
-            _PhaseSpec(
-                "lift", (k, k + 1), swing, round(config.lift_duration / dt), feet_a, lifted, com_b, com_b,
-                rot_b, rot_b, q_b, q_b, control,
-            ),
-        ]  # fmt: skip
+            shift(feet_a, com_a, coms[0], rot_a, rot_a, q_a, q_b),
+            dataclasses.replace(lift, com0=coms[0], coms=coms[1:]),
+        ]
     if on_a.sum() == 1 and on_b.all():
         swing = int(np.flatnonzero(~on_a)[0])
         stance = 1 - swing
         if not np.allclose(feet_a[stance], feet_b[stance], atol=1e-6):
             raise MotionError(f"postures {k} and {k + 1}: the {SIDES[stance]} (stance) sole moves")
         apex = _apex(terrain, feet_a[swing][:3, 3], feet_b[swing][:3, 3], config.swing_clearance)
-        control = landing_path(feet_a[swing][:3, 3], feet_b[swing][:3, 3], apex)
         landed = feet_a.copy()
         landed[swing] = feet_b[swing]
+        land = _PhaseSpec(
+            "land", (k, k + 1), swing, round(config.land_duration / dt), feet_a, landed, com_a, com_a,
+            rot_a, rot_b, q_a, q_a, apex,
+        )  # fmt: skip
+        land, coms = _single_support(talos, land, k, config)
         return [
-            _PhaseSpec(
-                "land", (k, k + 1), swing, round(config.land_duration / dt), feet_a, landed, com_a, com_a,
-                rot_a, rot_a, q_a, q_a, control,
-            ),
-            shift(feet_b, com_a, com_b, rot_a, rot_b, q_a, q_b),
-        ]  # fmt: skip
+            dataclasses.replace(land, com1=coms[-1], coms=coms[1:]),
+            shift(feet_b, coms[-1], com_b, rot_b, rot_b, q_a, q_b),
+        ]
     raise MotionError(
         f"postures {k} and {k + 1}: contacts {on_a.astype(int).tolist()} -> {on_b.astype(int).tolist()} "
         "(a motion goes from double support to one foot or back)"
     )
 
 
+def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[_PhaseSpec, np.ndarray]:
+    """A lift or land spec, lengthened where its CoM moves far, and its `single_support_coms`
+    [n + 1, 3] of samples 0..n.
+
+    The phase lasts long enough for the CoM's peak acceleration along its minimum-jerk
+    move to stay under `config.single_support_acceleration` (`paths.shift_duration`).
+
+    Raises:
+        MotionError: naming postures k and k + 1.
+    """
+    from leas_jax.motion.paths import shift_duration
+
+    coms = _single_support_coms(talos, spec, k, config)
+    distance = float(np.linalg.norm(coms[-1] - coms[0]))
+    seconds = shift_duration(
+        distance, config.single_support_acceleration, spec.samples * config.dt, config.dt
+    )
+    if round(seconds / config.dt) > spec.samples:
+        spec = dataclasses.replace(spec, samples=round(seconds / config.dt))
+        coms = _single_support_coms(talos, spec, k, config)
+    return spec, coms
+
+
+def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> np.ndarray:
+    """`single_support_coms` [n + 1, 3] of a lift or land spec's samples 0..n (MotionError
+    naming postures k and k + 1)."""
+    from leas_jax.motion.paths import slerp
+
+    fractions = np.arange(spec.samples + 1) / spec.samples
+    feet = swing_feet(spec, fractions)
+    rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
+    try:
+        return single_support_coms(
+            talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config
+        )
+    except MotionError as exc:
+        raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {exc}") from None
+
+
+def turn_scaling(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
+    """Progress [N] in [0, 1] of a phase's turns at normalised times fractions [N]: the
+    minimum-jerk scaling in a shift; in single support the swing sole's travel window, on
+    which the root turns too (the hip yaw between them then goes straight from one key
+    posture's to the other's, within its limits)."""
+    from leas_jax.motion.paths import LAND_WINDOWS, LIFT_WINDOWS, min_jerk, window
+
+    if spec.swing < 0:
+        return min_jerk(fractions)
+    return window(fractions, (LIFT_WINDOWS if spec.kind == "lift" else LAND_WINDOWS)[1])
+
+
+def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
+    """Sole references [N, 2, 4, 4] (world) of a phase at normalised times fractions [N] in [0, 1].
+
+    The swing sole follows `paths.swing_path` below spec.apex (LIFT_WINDOWS or
+    LAND_WINDOWS) and turns while it travels; at fraction 1 it is exactly at spec.feet1.
+    """
+    from leas_jax.motion.paths import LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
+
+    feet = np.repeat(spec.feet0[None], len(fractions), axis=0)
+    if spec.swing >= 0:
+        start, end = spec.feet0[spec.swing], spec.feet1[spec.swing]
+        windows = LIFT_WINDOWS if spec.kind == "lift" else LAND_WINDOWS
+        feet[:, spec.swing, :3, :3] = slerp(start[:3, :3], end[:3, :3], turn_scaling(spec, fractions))
+        feet[:, spec.swing, :3, 3] = swing_path(start[:3, 3], end[:3, 3], spec.apex, fractions, windows)
+        feet[np.asarray(fractions) >= 1.0, spec.swing] = spec.feet1[spec.swing]
+    return feet
+
+
 def phase_references(spec: _PhaseSpec, dt: float):
     """Task references of a phase's samples 1..n (sample 0 is the previous phase's end).
 
+    The CoM is spec.coms where set (single support), else straight from com0 to com1.
+
     Returns:
-        list of n (wbik.Targets, feet placements [2, 4, 4]).
+        list of n wbik.Targets (feet [2, 4, 4], CoM [3], root rotation [3, 3], upper body [39]).
     """
-    from leas_jax.motion.paths import bezier, lerp, min_jerk, slerp
+    from leas_jax.motion.paths import lerp, min_jerk, slerp
     from leas_jax.motion.wbik import Targets
 
     fractions = np.arange(1, spec.samples + 1) / spec.samples
     s = min_jerk(fractions)
-    coms = lerp(spec.com0, spec.com1, s)
-    rots = slerp(spec.rot0, spec.rot1, s)
+    coms = lerp(spec.com0, spec.com1, s) if spec.coms is None else spec.coms
+    rots = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     uppers = lerp(spec.upper0, spec.upper1, s)
-    feet = np.repeat(spec.feet0[None], spec.samples, axis=0)
-    if spec.swing >= 0:
-        positions = bezier(spec.control, s)
-        turns = slerp(spec.feet0[spec.swing][:3, :3], spec.feet1[spec.swing][:3, :3], s)
-        feet[:, spec.swing, :3, :3] = turns
-        feet[:, spec.swing, :3, 3] = positions
-        feet[-1, spec.swing] = spec.feet1[spec.swing]
+    feet = swing_feet(spec, fractions)
     return [Targets(feet[i], coms[i], rots[i], uppers[i]) for i in range(spec.samples)]
 
 
@@ -469,7 +694,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     frames = [posture_frames(talos, q) for q in plan.q]
     specs = []
     for k in range(len(plan) - 1):
-        specs.extend(_segment_phases(plan, k, frames, terrain, config))
+        specs.extend(_segment_phases(plan, k, frames, terrain, config, talos))
     ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
     q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
     contact_samples.append(_contacts(plan, 0))

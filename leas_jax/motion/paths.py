@@ -30,33 +30,41 @@ def shift_duration(distance: float, acceleration: float, minimum: float, dt: flo
     return math.ceil(max(needed, minimum) / dt - 1e-9) * dt
 
 
-def bezier(points: np.ndarray, s) -> np.ndarray:
-    """Bezier curve of control points [P, 3] at parameters s [N] in [0, 1] -> [N, 3] (de Casteljau)."""
-    points = np.asarray(points, dtype=np.float64)
-    s = np.asarray(s, dtype=np.float64)[:, None]
-    layer = [np.broadcast_to(p, (len(s), 3)) for p in points]
-    while len(layer) > 1:
-        layer = [(1.0 - s) * a + s * b for a, b in zip(layer[:-1], layer[1:])]
-    return np.array(layer[0])
+# Windows (rise, travel, descend) of a swing phase's normalised time [0, 1], each move on a
+# minimum-jerk scaling: the sole rises from its start to the apex, travels horizontally, and
+# comes down from the apex to its end. A lift travels once the sole has left the contact's
+# surroundings (the toe of a sole before a riser can be a centimetre from it, and the
+# plan's lifted foot is as little as 3.5 cm above the step's edge); a landing rises over
+# 0.7 of its time (from a key posture at rest, as slowly as a Bezier arc over all of it)
+# and has arrived above its contact before the last of the descent (a step down or back).
+LIFT_WINDOWS = ((0.0, 0.5), (0.3, 1.0), (0.5, 1.0))
+LAND_WINDOWS = ((0.0, 0.7), (0.35, 0.85), (0.6, 1.0))
 
 
-def lift_path(start: np.ndarray, end: np.ndarray) -> np.ndarray:
-    """Control points [3, 3] of a lift-off: leave the contact along +z, end at the lifted position.
+def window(t, span: tuple[float, float]) -> np.ndarray:
+    """Minimum-jerk progress in [0, 1] at normalised times t [N] of a move over span = (t0, t1)."""
+    t0, t1 = span
+    return min_jerk((np.asarray(t, dtype=np.float64) - t0) / (t1 - t0))
+
+
+def swing_path(start: np.ndarray, end: np.ndarray, apex: float, t, windows: tuple) -> np.ndarray:
+    """Positions [N, 3] (world) of a swing sole at normalised times t [N] in [0, 1].
+
+    The height rises from start's to `apex` in the rise window and comes down to end's in
+    the descent window; the horizontal position moves from start's to end's in the travel
+    window. Every coordinate has zero velocity and acceleration at t = 0 and 1; the sole
+    is at start at t = 0, at end at t = 1, and never above `apex`.
 
     Args:
-        start: [3] sole position in contact, world; end: [3] lifted sole position, world.
+        start, end: [3] sole positions, world; apex: m, at least both ends' heights.
+        windows: (rise, travel, descend) spans, LIFT_WINDOWS or LAND_WINDOWS.
     """
-    return np.array([start, [start[0], start[1], max(end[2], start[2])], end])
-
-
-def landing_path(start: np.ndarray, end: np.ndarray, apex: float) -> np.ndarray:
-    """Control points [4, 3] of a landing: rise to `apex` m, travel, come down along -z onto `end`.
-
-    Args:
-        start: [3] lifted sole position, world; end: [3] landing sole position, world;
-        apex: height of the middle control points, m (the curve stays below it).
-    """
-    return np.array([start, [start[0], start[1], apex], [end[0], end[1], apex], end])
+    rise, travel, descend = windows
+    start, end = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64)
+    out = np.empty((len(np.atleast_1d(t)), 3))
+    out[:, :2] = start[:2] + window(t, travel)[:, None] * (end[:2] - start[:2])
+    out[:, 2] = start[2] + (apex - start[2]) * window(t, rise) + (end[2] - apex) * window(t, descend)
+    return out
 
 
 def slerp(rot0: np.ndarray, rot1: np.ndarray, s) -> np.ndarray:

@@ -50,7 +50,6 @@ bench: $(STAMP)
 	$(PY) benchmarks/train_throughput.py
 	$(PY) benchmarks/contact_planner_speed.py
 	$(PY) benchmarks/planner_training_throughput.py
-	$(PY) benchmarks/walking_height.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info

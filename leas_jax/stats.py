@@ -1,8 +1,11 @@
-"""Interval statistics of proportions (success rates, sensitivities), host-only."""
+"""Interval statistics of proportions (success rates, sensitivities) and confusion counts of a
+condition against a ground truth, host-only."""
 
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 
 def wilson(successes: int, trials: int, z: float = 1.96) -> tuple[float, float]:
@@ -24,3 +27,37 @@ def newcombe_difference(a: tuple[int, int], b: tuple[int, int]) -> tuple[float, 
     low = pa - pb - math.sqrt((pa - la) ** 2 + (ub - pb) ** 2)
     high = pa - pb + math.sqrt((ua - pa) ** 2 + (pb - lb) ** 2)
     return pa - pb, low, high
+
+
+def confusion(predicted, truth) -> dict:
+    """Confusion counts and rates of a condition against a ground truth ([..., N] bool each).
+
+    Returns:
+        dict: tp, fn, fp, tn (condition true/false among feasible/infeasible poses),
+        sensitivity tp / (tp + fn) and specificity tn / (tn + fp) (NaN when undefined),
+        as Python numbers for a single condition, arrays for a batch.
+    """
+    predicted = np.asarray(predicted, dtype=bool)
+    truth = np.asarray(truth, dtype=bool)
+    tp = np.sum(predicted & truth, axis=-1)
+    fn = np.sum(~predicted & truth, axis=-1)
+    fp = np.sum(predicted & ~truth, axis=-1)
+    tn = np.sum(~predicted & ~truth, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sensitivity = np.where(tp + fn > 0, tp / np.maximum(tp + fn, 1), np.nan)
+        specificity = np.where(tn + fp > 0, tn / np.maximum(tn + fp, 1), np.nan)
+    out = {"tp": tp, "fn": fn, "fp": fp, "tn": tn, "sensitivity": sensitivity, "specificity": specificity}
+    if np.ndim(tp) == 0:
+        out = {k: (int(v) if k in ("tp", "fn", "fp", "tn") else float(v)) for k, v in out.items()}
+    return out
+
+
+def rates(predicted, truth) -> dict:
+    """`confusion` of one condition ([N] bool each) plus the 95 % Wilson intervals of its
+    sensitivity and specificity (`sensitivity_95ci`, `specificity_95ci`)."""
+    c = confusion(predicted, truth)
+    return {
+        **c,
+        "sensitivity_95ci": wilson(c["tp"], c["tp"] + c["fn"]),
+        "specificity_95ci": wilson(c["tn"], c["tn"] + c["fp"]),
+    }

@@ -162,47 +162,6 @@ def test_cpu_identity_tells_hosts_apart_by_family_model_and_vector_extension():
         assert common.machine()["vector_isa"] == common.cpu_identity(cpuinfo.read_text())["vector_isa"]
 
 
-def test_guide_failures_report_names_why_the_generator_stopped():
-    import guide_failures
-
-    assert guide_failures.main_reason({"leg IK": 2, "terrain collision: arm": 5}) == "terrain collision: arm"
-    assert guide_failures.main_reason({}) == "none"
-    failure = {"start": 0, "cell": "wall", "speed": 0.1, "yaw_rate": 0.0, "reason": "terrain collision: arm"}
-    failure["reasons"] = {"terrain collision: arm": 5}
-    report = {
-        "policy": "p", "terrain": "t", "spawns": "condition", "upper_bodies": ["half_sitting"],
-        "starts": 2, "seed": 0, "full_coverage": 0.5, "full_coverage_95ci": [0.1, 0.9],
-        "mean_coverage": 0.7, "failed_at_first_pose": 0, "mean_progress_m": 1.0, "valid_fraction": 1.0,
-        "failures": [failure], "failures_by_cell": {"wall": 1}, "cells_visited": {"wall": 10},
-        "failures_by_reason": {"terrain collision: arm": 1}, "failures_with_an_arm_collision": 1,
-        "what_if": {},
-    }  # fmt: skip
-    text = guide_failures.markdown(report)
-    assert "upper bodies half_sitting" in text
-    assert "| terrain collision: arm | 1 |" in text
-    assert "met the terrain or the legs at the failure: 1 / 1" in text
-
-
-def test_guide_failures_sets_generator_fields_from_the_command_line():
-    import argparse
-
-    import guide_failures
-
-    parser = argparse.ArgumentParser()
-    settings = common.generator_settings(["retry_settings=()", "max_candidates = 12"], parser)
-    assert settings == {"retry_settings": (), "max_candidates": 12}
-    for bad in ("no_such_field=1", "max_candidates", "lookahead=fast"):
-        with pytest.raises(SystemExit):
-            common.generator_settings([bad], parser)
-    report = {"policy": "p", "terrain": "t", "spawns": "condition", "upper_bodies": ["half_sitting"]}
-    report |= {"generator_settings": {"max_candidates": "12"}, "starts": 1, "seed": 0}
-    report |= {"full_coverage": 1.0, "full_coverage_95ci": [0.2, 1.0], "mean_coverage": 1.0}
-    report |= {"failed_at_first_pose": 0, "mean_progress_m": 1.0, "valid_fraction": 1.0}
-    report |= {"failures_by_cell": {}, "cells_visited": {}, "failures_by_reason": {}}
-    report |= {"failures_with_an_arm_collision": 0, "failures": [], "what_if": {}}
-    assert "half_sitting, max_candidates=12, 1 starts" in guide_failures.markdown(report)
-
-
 def test_cpu_busy_fraction_from_proc_stat():
     """/proc/stat's first line: user nice system idle iowait irq softirq steal guest guest_nice;
     busy is all but idle and iowait, over the first eight fields."""
@@ -213,84 +172,6 @@ def test_cpu_busy_fraction_from_proc_stat():
     assert common.busy_fraction(None, after) is None and common.busy_fraction(after, after) is None
     live = common.cpu_times()
     assert live is None or 0 <= live[0] <= live[1]
-
-
-def test_guide_failures_compare_pairs_the_same_episodes(tmp_path):
-    import guide_failures
-
-    from leas_jax.errors import UsageError
-
-    assert guide_failures.sign_test(0, 0) == 1.0
-    assert guide_failures.sign_test(14, 0) == pytest.approx(2 * 0.5**14)
-    assert guide_failures.sign_test(3, 3) == 1.0
-    same = {"policy": "p", "starts": 4, "seed": 0, "spawns": "condition", "terrain": "t"}
-    before = {**same, "full_coverage": 0.25, "failures": [{"start": k} for k in (0, 1, 2)]}
-    after = {**same, "full_coverage": 0.5, "failures": [{"start": k} for k in (2, 3)]}
-    for name, report in (("b.json", before), ("a.json", after)):
-        (tmp_path / name).write_text(json.dumps(report))
-    result = guide_failures.main(
-        ["--compare", str(tmp_path / "b.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
-    )
-    assert result["fixed"] == [0, 1] and result["broken"] == [3]
-    assert json.loads((tmp_path / "paired.json").read_text())["p_sign_test"] == pytest.approx(1.0)
-    (tmp_path / "o.json").write_text(json.dumps({**after, "seed": 1}))
-    with pytest.raises(UsageError, match="seed"):
-        guide_failures.main(
-            ["--compare", str(tmp_path / "b.json"), str(tmp_path / "o.json"), "--out", str(tmp_path)]
-        )
-    with pytest.raises(UsageError, match="missing.json"):
-        guide_failures.main(
-            ["--compare", str(tmp_path / "missing.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
-        )
-    # The same weights under another path (a run folder and the checkpoint copied from it) pair.
-    (tmp_path / "run").mkdir()
-    (tmp_path / "run" / "policy.ckpt").write_bytes(b"weights")
-    (tmp_path / "copy.ckpt").write_bytes(b"weights")
-    (tmp_path / "other.ckpt").write_bytes(b"other weights")
-    digests = {
-        name: guide_failures.policy_digest(tmp_path / name) for name in ("run", "copy.ckpt", "other.ckpt")
-    }
-    assert digests["run"] == digests["copy.ckpt"] != digests["other.ckpt"]
-    (tmp_path / "b.json").write_text(json.dumps({**before, "policy": "run", "policy_sha256": digests["run"]}))
-    (tmp_path / "a.json").write_text(
-        json.dumps({**after, "policy": "copy.ckpt", "policy_sha256": digests["copy.ckpt"]})
-    )
-    (tmp_path / "o.json").write_text(
-        json.dumps({**after, "policy": "other.ckpt", "policy_sha256": digests["other.ckpt"]})
-    )
-    paths = [str(tmp_path / "b.json"), str(tmp_path / "a.json"), "--out", str(tmp_path)]
-    assert guide_failures.main(["--compare", *paths])["fixed"] == [0, 1]
-    with pytest.raises(UsageError, match="policy"):
-        guide_failures.main(
-            ["--compare", str(tmp_path / "b.json"), str(tmp_path / "o.json"), "--out", str(tmp_path)]
-        )
-
-
-def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
-    """RBKino from a start turned 60-120 degrees from the target at 0.01 m/s turns its root
-    30-75 degrees between two poses 0.1 s apart: the generator stops at its first pose.
-    Sampled every 0.01 s, as HPP's contact generator samples the path, and judged at the
-    same 0.5 s planning interval, it is followed to the goal."""
-    import table2_baselines as table2
-
-    from leas_jax.contacts import GeneratorConfig
-    from leas_jax.eval.scenarios import cells_for
-    from leas_jax.steering.baselines import BaselineConfig
-    from leas_jax.terrain.generate import scenario_file
-
-    assert GeneratorConfig().planning_stride(0.01) == 50 and GeneratorConfig().planning_stride(0.1) == 5
-    terrain = load_terrain(scenario_file("ground"))
-    env = EnvConfig()
-    base = BaselineConfig.from_env(env)
-    field = heightfield_from_terrain(terrain, env)
-    cells = cells_for("ground", terrain.scenario)
-    turned = next(k for k, c in enumerate(cells) if c.yaw_deg == (60.0, 120.0) and c.speed[0] == 0.01)
-    jobs = [(v, "rbkino", table2.VARIANTS[v][1], [turned]) for v in ("rbkino", "rbkino_dt001")]
-    coarse, fine = table2.build(jobs, terrain, field, cells, 1, base, env)
-    assert len(fine.guide) > 9 * len(coarse.guide) and (coarse.timestep, fine.timestep) == (0.1, 0.01)
-    table2.judge(terrain, [coarse, fine], base.timestep, 0, None)
-    assert coarse.outcome.last_valid_index == 0
-    assert fine.outcome.coverage == 1.0 and fine.outcome.success
 
 
 def test_contact_planner_speed_times_the_generator_with_the_settings_given(tmp_path):

@@ -1,4 +1,4 @@
-"""Reachability calibration machinery (benchmarks/reachability_calibration.py) on obvious cases.
+"""Reachability calibration machinery (studies/reachability_calibration.py) on obvious cases.
 
 A 6 x 6 m slab with a 1.5 m wall: roots at the nominal height over open ground are
 feasible for the contact generator and valid for the condition; roots far above the
@@ -18,13 +18,15 @@ import pytest
 from leas_jax.contacts.planner.generator import ContactPosture, double_support_posture
 from leas_jax.contacts.robot.model import NOMINAL_ROOT_HEIGHT
 from leas_jax.env import ReachabilityConfig
+from leas_jax.feasibility.poses import Z_OFFSETS, cylinder_verdicts, sample_poses
 from leas_jax.feasibility.walking_truth import WALK_POSES, walking_guide
+from leas_jax.stats import confusion
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import REACHABILITY_TERMS_OFF
 
-# Imported by name from benchmarks/ (on sys.path, which spawned pool workers inherit) so
+# Imported by name from studies/ (on sys.path, which spawned pool workers inherit) so
 # that the pool can pickle its functions.
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "studies"))
 import reachability_calibration as rc  # noqa: E402
 
 TERRAIN = load_terrain(Path(__file__).parent / "data" / "slab_with_wall.toml")  # wall: x 4.3-4.7, y 1-5
@@ -93,7 +95,7 @@ def test_condition_on_obvious_cases_old_and_new_defaults():
         leg_top=-0.54,
     )
     for config in (old, ReachabilityConfig()):
-        predicted = rc.condition(TERRAIN, POSES, config)
+        predicted = cylinder_verdicts(TERRAIN, POSES, config)
         np.testing.assert_array_equal(predicted, EXPECTED)
         # The search's NumPy form agrees with the jitted condition, on these poses and on
         # the thresholds that flip them (the high roots become valid with a low enough leg_bottom).
@@ -106,21 +108,21 @@ def test_condition_on_obvious_cases_old_and_new_defaults():
         low = dataclasses.replace(config, leg_bottom=-2.1)
         np.testing.assert_array_equal(
             rc.thresholds(samples, low.trunk_bottom, low.leg_bottom, low.leg_top),
-            rc.condition(TERRAIN, POSES, low),
+            cylinder_verdicts(TERRAIN, POSES, low),
         )
-        assert rc.condition(TERRAIN, POSES, low)[16:28].all()
+        assert cylinder_verdicts(TERRAIN, POSES, low)[16:28].all()
 
 
 def test_confusion_counts_by_hand():
     truth = np.array([1, 1, 1, 1, 0, 0, 0, 0, 0, 0], dtype=bool)
     predicted = np.array([1, 1, 1, 0, 1, 0, 0, 0, 0, 0], dtype=bool)
-    c = rc.confusion(predicted, truth)
+    c = confusion(predicted, truth)
     assert (c["tp"], c["fn"], c["fp"], c["tn"]) == (3, 1, 1, 5)
     assert c["sensitivity"] == pytest.approx(0.75) and c["specificity"] == pytest.approx(5 / 6)
-    batch = rc.confusion(np.stack([predicted, truth, ~truth]), truth)  # [3, N]: rates per row
+    batch = confusion(np.stack([predicted, truth, ~truth]), truth)  # [3, N]: rates per row
     np.testing.assert_allclose(batch["sensitivity"], [0.75, 1.0, 0.0])
     np.testing.assert_allclose(batch["specificity"], [5 / 6, 1.0, 0.0])
-    assert math.isnan(rc.confusion(predicted[4:], truth[4:])["sensitivity"])  # no feasible pose
+    assert math.isnan(confusion(predicted[4:], truth[4:])["sensitivity"])  # no feasible pose
 
 
 def test_flat_ground_constraint():
@@ -151,15 +153,15 @@ def test_tiny_grid_search_separates_the_cases(truth):
 
 
 def test_sample_poses_seeded_and_in_range():
-    poses = rc.sample_poses(TERRAIN, 200, seed=5)
-    np.testing.assert_array_equal(poses, rc.sample_poses(TERRAIN, 200, seed=5))
+    poses = sample_poses(TERRAIN, 200, seed=5)
+    np.testing.assert_array_equal(poses, sample_poses(TERRAIN, 200, seed=5))
     assert poses.shape == (200, 4)
     assert np.all((poses[:, :2] >= 0.3) & (poses[:, :2] <= 5.7))
     assert np.all(np.abs(poses[:, 3]) <= math.pi)
     # z: reference ground (highest within 0.15 m: 0 on the slab, 1.5 near the wall) + 1.0 + offset.
     on_slab = poses[:, 0] < 3.5
     offsets = poses[on_slab, 2] - 1.0
-    assert offsets.min() >= rc.Z_OFFSETS[0] and offsets.max() <= rc.Z_OFFSETS[1]
+    assert offsets.min() >= Z_OFFSETS[0] and offsets.max() <= Z_OFFSETS[1]
     # 30 % near the wall (the only obstacle): within 0.35 m + a cell of its footprint.
     near = (poses[:, 0] > 4.3 - 0.37) & (poses[:, 0] < 4.7 + 0.37)
     assert near.sum() >= 0.3 * 200
@@ -205,9 +207,9 @@ def test_hands_term_catches_grippers_beside_the_wall():
     truth = rc.ground_truth(TERRAIN, poses, workers=1)
     assert truth[:16].all() and not truth[16:].any()
     base = ReachabilityConfig(trunk_radius=0.20, **REACHABILITY_TERMS_OFF)  # cylinders alone
-    assert rc.condition(TERRAIN, poses, base).all()  # every pose passes without the hands
+    assert cylinder_verdicts(TERRAIN, poses, base).all()  # every pose passes without the hands
     hands = dataclasses.replace(base, hand_radius=0.13)
-    predicted = rc.condition(TERRAIN, poses, hands)
+    predicted = cylinder_verdicts(TERRAIN, poses, hands)
     np.testing.assert_array_equal(predicted, truth)
     samples = rc.raster_samples(
         TERRAIN, poses, base.trunk_radius, base.leg_radius, base.leg_lateral_offset, hand_radius=0.13

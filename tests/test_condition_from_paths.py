@@ -1,11 +1,11 @@
-"""benchmarks/condition_from_paths.py: per-path agreement of a condition with the generator."""
+"""studies/condition_from_paths.py: per-path agreement of a condition with the generator."""
 
 import sys
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "studies"))
 
 import condition_from_paths as cfp  # noqa: E402
 

@@ -441,7 +441,7 @@ def test_lifted_foot_clears_a_stance_sole_near_the_guide_line():
 
 def test_a_step_falls_back_to_the_place_under_the_root():
     """The first 16 s of a shipped-policy guide on the training arena's stairs pit (start 236
-    of benchmarks/guide_failures.py, evaluation seed 0): at pose 120 the left foot lags
+    of studies/guide_failures.py, evaluation seed 0): at pose 120 the left foot lags
     0.30 m behind its place and no foothold within `candidate_radius` of its place 0.7 s
     ahead gives a posture, nor does the right foot's step; the plan stopped at pose 115.
     A step toward the foot's place under the planning pose itself
@@ -554,7 +554,7 @@ def test_first_stance_steps_away_from_a_box_beside_a_shin():
 
 def test_root_steps_sideways_off_a_pillar_the_arms_meet():
     """The first 3 s of a shipped-policy guide starting beside one of the training arena's
-    pillars (start 12 of benchmarks/guide_failures.py, evaluation seed 0): the policy turns
+    pillars (start 12 of studies/guide_failures.py, evaluation seed 0): the policy turns
     on the spot with the pillar's face inside the reach of the shoulders (0.38 m to the side
     of the root even with the arms held in), so every posture from pose 10 on met it and the
     plan stopped at pose 5. With the root shifted sideways off the guide

@@ -1,7 +1,7 @@
-"""benchmarks/feasibility_data.py: the labels' cache key and its invalidation, resuming a build."""
+"""The learned condition's data: the labels' cache key and its invalidation, resuming a build,
+weights fitted on another generator named stale."""
 
 import dataclasses
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -10,9 +10,6 @@ import pytest
 from leas_jax.contacts.planner.generator import GeneratorConfig
 from leas_jax.feasibility.label_cache import cached_labels, load_partial
 from leas_jax.feasibility.walking_truth import dataset_key
-
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
-import feasibility_data as fd  # noqa: E402
 
 TERRAIN = (Path(__file__).parent / "data" / "slab_with_wall.toml").read_text()
 
@@ -71,10 +68,6 @@ def test_cache_reused_rebuilt_when_the_key_changes_and_resumed(tmp_path):
     rest = Labeller()
     np.testing.assert_array_equal(cached_labels(poses, key, resumed_path, rest, chunk=10), labels)
     assert rest.poses == 5
-
-
-def test_cache_file_names_hold_the_key():
-    assert fd.cache_file("fresh10_seed1", "ab" * 32).name == f"feasibility_fresh10_seed1_{'ab' * 8}.npz"
 
 
 def test_weights_fitted_on_another_generator_are_named_stale():

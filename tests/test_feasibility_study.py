@@ -1,4 +1,4 @@
-"""benchmarks/feasibility_study.py: the two-level bootstrap, the table and plot, and the whole
+"""studies/feasibility_study.py: the two-level bootstrap, the table and plot, and the whole
 study end to end on tiny settings (four methods, tiny training and evaluation)."""
 
 import json
@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "studies"))
 import feasibility_study as fs  # noqa: E402
 
 from leas_jax.errors import UsageError  # noqa: E402

@@ -3,6 +3,7 @@ from synthetic data, the weights file, its selection as the env's termination co
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 
 import jax
@@ -190,21 +191,17 @@ def test_env_selects_the_learned_condition(tmp_path):
 
 
 def test_shipped_weights_agree_with_the_generator_on_held_out_poses():
-    """Parity: the committed weights (benchmarks/feasibility_condition.py) against the contact
+    """Parity: the committed weights (`leas feasibility condition`) against the contact
     generator's walking truth on 24 arena poses none of their data holds (seed 99). On 4 000
     fresh poses they reach 92.1 % sensitivity and 95.1 % specificity (~94 % agreement);
     below 70 % on 24 poses would have probability < 1e-3 at that rate."""
-    import sys
-
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
-    import reachability_calibration as rc
-
     from leas_jax.contacts.planner.generator import ContactGenerator
+    from leas_jax.feasibility.poses import ARENA, sample_poses
 
-    arena = load_terrain(rc.ARENA)
+    arena = load_terrain(ARENA)
     config = dataclasses.replace(EnvConfig(), condition="learned")  # the shipped weights, calibrated margins
     field = heightfield_from_terrain(arena, config)
-    poses = rc.sample_poses(arena, 24, seed=99)
+    poses = sample_poses(arena, 24, seed=99)
     ours = np.asarray(
         jax.jit(jax.vmap(lambda p: condition.valid(field, p, config)))(jnp.asarray(poses, jnp.float32))
     )
@@ -285,35 +282,56 @@ def test_train_command_takes_other_condition_weights(tmp_path):
         config_from_args(parser.parse_args([*base, "--condition-weights", str(weights)]))
 
 
-def test_feasibility_condition_benchmark_runs_end_to_end(tmp_path, monkeypatch):
-    """benchmarks/feasibility_condition.py on tiny settings: labels (cached under tmp_path),
-    fit, weights with their data key, and the report with the machine, load and commit."""
-    import sys
+def test_feasibility_condition_command_runs_end_to_end(tmp_path, capsys, monkeypatch):
+    """`leas feasibility condition` on tiny settings: labels (cached under --cache, reused by a
+    second build), fit, weights with their data key, and the report with the machine, load and
+    commit; bad options are refused in one line with exit code 2."""
+    from leas_jax.cli import main
+    from leas_jax.feasibility import walkability
 
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
-    import feasibility_condition as bench
-    import feasibility_data as fd
-
-    monkeypatch.setattr(fd, "cache_file", lambda name, key: tmp_path / f"labels_{name}_{key[:16]}.npz")
     weights = tmp_path / "w.npz"
     report = tmp_path / "report"
     params = lf.init_params(jax.random.PRNGKey(0), reach=EnvConfig().reachability)
     reject = lf.save_params(tmp_path / "reject.npz", {**params, "threshold": jnp.asarray(1e9)})
-    tiny = ["--train-poses", "24", "--test-poses", "12", "--policy-train-poses", "0", "--policy-poses", "0"]
-    tiny += ["--workers", "0", "--steps", "20", "--cost-envs", "0", "--weights", str(weights)]
-    bench.main([*tiny, "--compare-weights", str(reject), "--out", str(report)])
+    tiny = ["feasibility", "condition", "--train-poses", "24", "--test-poses", "12"]
+    tiny += ["--policy-train-poses", "0", "--policy-poses", "0", "--workers", "0", "--steps", "20"]
+    tiny += ["--cost-envs", "0"]
+    tiny += ["--weights", str(weights), "--cache", str(tmp_path / "cache")]
+    assert main([*tiny, "--compare-weights", str(reject), "--out", str(report)]) == 0
+    labels = sorted(
+        p.relative_to(tmp_path / "cache" / "condition") for p in (tmp_path / "cache").rglob("*.npz")
+    )
+    assert [p.parts[0] for p in labels] == ["fresh12_seed11", "fresh24_seed13"]
     saved = json.loads((report / "feasibility_condition.json").read_text())
-    assert {"machine", "git", "load_average_before"} <= set(saved)
+    assert saved["command"] == "leas feasibility condition"
+    assert {"machine", "git", "load_average_before", "load_average_after"} <= set(saved)
     learned = saved["validation"]["fresh"]["learned"]
     assert learned["tp"] + learned["fn"] + learned["fp"] + learned["tn"] == 12
     # other weights validated on the same poses: these call every pose infeasible
     rejecting = saved["validation"]["fresh"][f"learned ({reject})"]
     assert rejecting["tp"] == rejecting["fp"] == 0 and rejecting["fn"] == learned["tp"] + learned["fn"]
-    with pytest.raises(SystemExit):
-        bench.main([*tiny, "--compare-weights", str(tmp_path / "missing.npz")])
     params, metadata = lf.load_params(weights)
-    assert metadata["data_key"] == saved["data_key"]
+    assert metadata["data_key"] == saved["data_key"] and metadata["terrain"] == "terrains/training_arena.toml"
     assert "| fresh |" in (report / "feasibility_condition.md").read_text()
+
+    def refuse(chunk):
+        raise AssertionError("the cache holds these labels")
+
+    monkeypatch.setattr(walkability, "_walk", refuse)
+    assert main(tiny) == 0  # the same labels, from the cache; the report beside the weights
+    again = json.loads((tmp_path / "feasibility_condition.json").read_text())
+    assert again["data"]["feasible_fraction"] == saved["data"]["feasible_fraction"]
+    capsys.readouterr()
+    for bad, message in (
+        (
+            ["--compare-weights", str(tmp_path / "missing.npz")],
+            "--compare-weights .*missing.npz: no such file",
+        ),
+        (["--test-seed", "13"], "seeds must differ"),
+    ):
+        assert main([*tiny, *bad]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and re.search(message, err), err
 
 
 def test_clearance_probes_are_judged_by_the_selected_condition(tmp_path):

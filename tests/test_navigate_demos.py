@@ -1,5 +1,5 @@
 """The HPP group's scenes (terrains/hpp/demos, terrains/hpp/rough) and
-benchmarks/navigate_demos.py, which navigates their queries and verifies each plan.
+studies/navigate_demos.py, which navigates their queries and verifies each plan.
 
 The demo files must hold the queries of hpp-rbprm-corba's Talos scripts (HPP_QUERIES,
 copied from talos_*_path.py of its v4.12.0), the rough scenes 20 starts and a target on
@@ -21,7 +21,7 @@ import pytest
 from leas_jax.terrain import load_terrain
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path[:0] = [str(ROOT / "studies"), str(ROOT / "benchmarks")]
 
 import common  # noqa: E402
 import navigate_demos as bench  # noqa: E402

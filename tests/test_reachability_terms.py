@@ -206,9 +206,10 @@ def test_spawn_points_keep_the_foothold(ridged_terrain):
 
 
 def test_calibration_numpy_form_matches_the_jitted_terms(hole_terrain):
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "studies"))
     import reachability_calibration as rc
 
+    from leas_jax.feasibility.poses import cylinder_verdicts, sample_poses
     from leas_jax.terrain import loads_terrain
 
     terrain = loads_terrain("""name = "terms_cases"
@@ -225,13 +226,13 @@ size = [2.0, 0.04, 0.05]
 center = [3.0, 2.0, -0.1]
 size = [2.0, 1.0, 0.2]
 """)
-    poses = rc.sample_poses(terrain, 400, seed=3)
+    poses = sample_poses(terrain, 400, seed=3)
     for reach in (
         plain_with(leg_forward=0.15),
         plain_with(foothold_radius=0.065, foothold_search=0.10, foothold_spread=0.02),
         plain_with(leg_forward=0.1, foothold_spread=0.01, trunk_radius=0.2),
     ):
-        jitted = rc.condition(terrain, poses, reach)
+        jitted = cylinder_verdicts(terrain, poses, reach)
         foothold = None if reach.foothold_spread is None else (reach.foothold_radius, reach.foothold_search)
         samples = rc.raster_samples(
             terrain,
@@ -247,7 +248,7 @@ size = [2.0, 1.0, 0.2]
         )
         np.testing.assert_array_equal(numpy, jitted)
         # the term matters on these poses: it rejects some that the plain condition accepts
-        assert np.sum(rc.condition(terrain, poses, PLAIN) & ~jitted) > 0
+        assert np.sum(cylinder_verdicts(terrain, poses, PLAIN) & ~jitted) > 0
 
 
 def test_default_spawn_points_are_valid_for_every_yaw():

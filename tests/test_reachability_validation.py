@@ -1,4 +1,4 @@
-"""benchmarks/reachability_validation.py: intervals, the root-frame heightmap, the learned
+"""studies/reachability_validation.py: intervals, the root-frame heightmap, the learned
 reference on data with a known answer, and a small end-to-end run on the arena."""
 
 import json
@@ -9,9 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from leas_jax.stats import rates, wilson
 from leas_jax.terrain import load_terrain
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT / "studies"), str(ROOT / "benchmarks")]
 import common  # noqa: E402
 import reachability_calibration as rc  # noqa: E402
 import reachability_validation as rv  # noqa: E402
@@ -22,11 +24,20 @@ WALL = load_terrain(
 
 
 def test_wilson_interval_by_hand():
-    lo, hi = rv.wilson(95, 100)
+    lo, hi = wilson(95, 100)
     assert lo == pytest.approx(0.8882, abs=1e-4) and hi == pytest.approx(0.9785, abs=1e-4)
-    lo, hi = rv.wilson(0, 10)
+    lo, hi = wilson(0, 10)
     assert lo == pytest.approx(0.0, abs=1e-12) and 0.2 < hi < 0.35
-    assert all(math.isnan(v) for v in rv.wilson(0, 0))
+    assert all(math.isnan(v) for v in wilson(0, 0))
+
+
+def test_rates_carry_the_wilson_intervals_of_both_rates():
+    predicted = np.array([True] * 19 + [False] + [True] * 2 + [False] * 8)
+    truth = np.array([True] * 20 + [False] * 10)
+    r = rates(predicted, truth)
+    assert (r["tp"], r["fn"], r["fp"], r["tn"]) == (19, 1, 2, 8)
+    assert r["sensitivity"] == pytest.approx(0.95) and r["specificity"] == pytest.approx(0.8)
+    assert r["sensitivity_95ci"] == wilson(19, 20) and r["specificity_95ci"] == wilson(8, 10)
 
 
 def _value_at(features, x, y):

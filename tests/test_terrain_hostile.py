@@ -11,7 +11,7 @@ import pytest
 from leas_jax.terrain import TerrainError, loads_terrain
 from leas_jax.terrain.loader import MAX_BOXES, MAX_NESTING, MAX_STARTS
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "studies"))
 import terrain_fuzz  # noqa: E402
 
 SOURCE = "hostile.toml"

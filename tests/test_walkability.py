@@ -1,6 +1,6 @@
 """The walkability model: terrain families, the plausible set and the model's verdicts (shapes,
 jit), a known rule learned from synthetic labels, the label cache's invalidation, rates, and the
-`leas walkability` command's errors."""
+`leas feasibility walkability` command's errors."""
 
 from __future__ import annotations
 
@@ -142,7 +142,7 @@ def test_walkability_command_errors_are_one_line(args, message, tmp_path):
     import re
 
     run = subprocess.run(
-        [sys.executable, "-m", "leas_jax.cli", "walkability", *args],
+        [sys.executable, "-m", "leas_jax.cli", "feasibility", "walkability", *args],
         capture_output=True,
         text=True,
         cwd=tmp_path,

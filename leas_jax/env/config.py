@@ -15,7 +15,7 @@ class ReachabilityConfig:
 
     docs/design.md §5 starts from the `talos_trunk` and `talos_*leg_rom` volumes of the HPP
     Talos data (trunk r 0.30 m [-0.63, +0.60], legs r 0.25 m [-1.06, -0.54]). The
-    defaults below were calibrated by benchmarks/reachability_calibration.py against
+    defaults below were calibrated by studies/reachability_calibration.py against
     the contact generator *walking* (`--truth walking --poses 48000`: a pose is feasible
     when the generator covers a 0.36 m straight guide from it; 48 000 poses of
     terrains/training_arena.toml). The static truth (one balanced, collision-free
@@ -24,7 +24,7 @@ class ReachabilityConfig:
     Against the current generator these defaults give sensitivity 95.7 % and specificity
     90.0 % on the 48 000 poses (95.7 / 90.0 % on the two thirds the search fits, 95.6 /
     90.1 % on the held-out third) and 95.5 / 90.2 % on 36 000 fresh poses
-    (benchmarks/reachability_validation.py, seed 1). Cylinders alone cannot: their best
+    (studies/reachability_validation.py, seed 1). Cylinders alone cannot: their best
     at >= 95 % sensitivity is 95.4 / 84.8 %. The three optional terms below close the gap
     and are on by default: the lookahead legs 0.30 m ahead (ground where the next steps
     land), the foothold (a sole-sized disk of even ground near each leg) and the hands
@@ -50,7 +50,7 @@ class ReachabilityConfig:
     leg_top: float = (
         -0.75
     )  # m below the root: highest reachable sole height, calibrated (docs/design.md §5: -0.54)
-    # Optional terms (benchmarks/reachability_false_positives.py finds the false positives
+    # Optional terms (studies/reachability_false_positives.py finds the false positives
     # they target). The calibration turns all three on.
     # m, lookahead: a second pair of leg cylinders at (leg_forward, ±leg_lateral_offset) in the
     # root frame (same radius and band) must touch too: ground where the next steps land.
@@ -171,7 +171,7 @@ class EnvConfig:
     # Termination condition: "cylinders", the paper's reachability condition with
     # `reachability`'s cylinders and terms, or "learned", the network of
     # `leas_jax.env.learned_feasibility` trained on the contact generator's walking verdicts
-    # (benchmarks/feasibility_condition.py), with its weights in `learned_weights` (an .npz,
+    # (`leas feasibility condition`), with its weights in `learned_weights` (an .npz,
     # relative to the repository root unless it exists as given). The spawn points stay those
     # of the cylinders in both cases (a fallback that is valid for every yaw).
     condition: str = "cylinders"

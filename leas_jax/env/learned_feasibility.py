@@ -8,13 +8,13 @@ It reads
     regular grid turning with the yaw (`patch_grid`; nearest raster cell, the void height
     off the raster), clipped to `clip`;
   - the root's height above the local ground: z minus the highest terrain point of the
-    patch within `GROUND_RADIUS` of the root (benchmarks/reachability_calibration.py draws
+    patch within `GROUND_RADIUS` of the root (studies/reachability_calibration.py draws
     its poses relative to that ground);
   - the cylinders' own margins (`reachability.margins` with the env's ReachabilityConfig,
     the calibrated one by default): the network refines the calibrated condition's
     boundary instead of learning the whole geometry from a few thousand verdicts (on
     3 200 fresh poses, the patch alone reached 99.0 / 64.7 % on fresh poses where the
-    calibrated cylinders give 96.0 / 91.5 %: benchmarks/feasibility_condition.py's README);
+    calibrated cylinders give 96.0 / 91.5 %: docs/results/2026-12-01-feasibility);
 
 standardises them and runs a tanh MLP to one logit. The pose is feasible when the logit
 is at least the stored threshold. Everything, grid included, is data in one dict of

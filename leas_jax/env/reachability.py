@@ -16,7 +16,7 @@ A pose is valid when
     most such poses.
 Three optional terms (the calibrated defaults of `ReachabilityConfig` turn all three
 on; the training presets' `TRAINING_REACHABILITY` none; see
-benchmarks/reachability_false_positives.py for the false positives they target):
+studies/reachability_false_positives.py for the false positives they target):
   - lookahead (`leg_forward` != 0): a second pair of leg cylinders centred at
     (leg_forward, ±leg_lateral_offset) in the root frame, same radius and band,
     must touch as well: ground where the next steps land along the heading;

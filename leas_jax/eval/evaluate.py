@@ -592,7 +592,7 @@ def evaluate(
             rolls on through such poses and the contact generator alone judges its
             path, as it judges the baselines' paths, which nothing cuts either (the
             paper's RBLin paths "lead inside the hole", §IV-B.2). The condition is a
-            training proxy of the generator (benchmarks/reachability_calibration.py:
+            training proxy of the generator (studies/reachability_calibration.py:
             ~85 % specificity, and it rejects poses the generator walks through: 8 of
             the shipped policy's 10 circuit paths meet a rejected pose on a step down
             that the generator then walks).

@@ -1,4 +1,9 @@
-"""`leas walkability`: build the walkability model (data, fit, report) in one command."""
+"""`leas feasibility`: build a learned feasibility model (data, fit, report) in one command.
+
+Two targets: `condition`, the env's learned termination condition on the training arena
+(`condition_build`), and `walkability`, the walkability model of rough ground that navigate's
+lattice reads (`walkability`, on procedural terrain families).
+"""
 
 from __future__ import annotations
 
@@ -24,17 +29,47 @@ def _scenes(patterns: list[str]):
     return [load_terrain(f) for f in files]
 
 
+def cmd_condition(args) -> int:
+    """Label, fit, write the weights and the report of the learned condition."""
+    from leas_jax.feasibility.condition_build import ConditionBuild, build
+    from leas_jax.files import resolve_data_path
+
+    for other in args.compare_weights:
+        if not resolve_data_path(other).is_file():
+            raise UsageError(f"--compare-weights {other}: no such file")
+    if args.train_seed == args.test_seed or args.policy_train_seed == args.policy_seed:
+        raise UsageError("the training and validation seeds must differ (the validation poses must be fresh)")
+    options = ConditionBuild(
+        **{
+            f: getattr(args, f)
+            for f in ("train_poses", "train_seed", "policy_train_poses", "policy_train_seed")
+        },
+        **{f: getattr(args, f) for f in ("test_poses", "test_seed", "policy_poses", "policy_seed", "policy")},
+        **{
+            f: getattr(args, f)
+            for f in ("workers", "steps", "weights", "cost_envs", "cost_steps", "cost_repeats")
+        },
+        mirror=not args.no_mirror,
+        compare_weights=tuple(args.compare_weights),
+        cache=args.cache,
+    )
+    out = Path(args.out) if args.out else resolve_data_path(args.weights).parent
+    build(options, out)
+    print(f"wrote {out / 'feasibility_condition.json'} and {out / 'feasibility_condition.md'}")
+    return 0
+
+
 def cmd_walkability(args) -> int:
     """Label, fit, write the weights and the report; print the report's table."""
     import dataclasses
 
     from leas_jax.feasibility.families import FAMILIES
-    from leas_jax.feasibility.walkability import WalkabilityConfig, build, report_table
+    from leas_jax.feasibility.walkability import HELD_OUT, WEIGHTS, WalkabilityConfig, build, report_table
 
-    out = Path(args.out)
+    out = Path(WEIGHTS if args.out is None else args.out)
     if out.suffix != ".npz":
         raise UsageError(f"--out: expected a .npz file, got {args.out}")
-    held = tuple(f for f in args.held_out.split(",") if f)
+    held = HELD_OUT if args.held_out is None else tuple(f for f in args.held_out.split(",") if f)
     unknown = [f for f in held if f not in FAMILIES]
     if unknown:
         raise UsageError(f"--held-out: unknown families {', '.join(unknown)} (known: {', '.join(FAMILIES)})")
@@ -56,25 +91,121 @@ def cmd_walkability(args) -> int:
 
 
 def register(subparsers) -> None:
-    """Add `walkability` to the `leas` parser."""
-    from leas_jax.feasibility.walkability import HELD_OUT, WEIGHTS
-
+    """Add `feasibility` with its targets `condition` and `walkability` to the `leas` parser."""
     parser = subparsers.add_parser(
+        "feasibility",
+        help="build a learned feasibility model: the env's condition or navigate's walkability",
+        description="Label root poses with the contact generator's walking truth (cached, resumable), "
+        "fit the network and report it against the cylinders. Targets: condition (the env's learned "
+        "termination condition on the training arena) and walkability (rough ground, for navigate).",
+    )
+    targets = parser.add_subparsers(dest="feasibility_target", metavar="TARGET", required=True)
+    _register_condition(targets)
+    _register_walkability(targets)
+
+
+def _register_condition(targets) -> None:
+    """Add `condition`: the options of `condition_build.ConditionBuild`."""
+    from leas_jax.feasibility.condition_build import DEFAULT_WEIGHTS, ConditionBuild
+
+    d = ConditionBuild()
+    parser = targets.add_parser(
+        "condition",
+        help="the env's learned termination condition on the training arena (data, fit, report)",
+        description="Label fresh arena poses and poses of a policy's arena guides with the contact "
+        "generator's walking truth (cached in --cache, rebuilt when the terrain, the generator's settings "
+        "or its code change), fit the learned condition, write its weights and report sensitivity and "
+        "specificity (95 % intervals) on other fresh and policy poses against the cylinders, and its "
+        "cost per env step. Relabel after a change to the generator (about 20 min on 2 cores).",
+    )
+    for name, what in (
+        ("train-poses", "fresh poses of the fit"),
+        ("test-poses", "fresh poses of the validation"),
+    ):
+        default = getattr(d, name.replace("-", "_"))
+        parser.add_argument(
+            f"--{name}", type=positive_int, default=default, help=f"{what} (default {default})"
+        )
+    for name, what in (
+        ("policy-train-poses", "poses of the policy's guides in the fit, 0: none"),
+        ("policy-poses", "poses of the policy's guides in the validation, 0: none"),
+        ("train-seed", "seed of the fit's fresh poses"),
+        ("policy-train-seed", "seed of the fit's policy poses"),
+        ("test-seed", "seed of the validation's fresh poses"),
+        ("policy-seed", "seed of the validation's policy poses"),
+    ):
+        default = getattr(d, name.replace("-", "_"))
+        parser.add_argument(
+            f"--{name}", type=non_negative_int, default=default, help=f"{what} (default {default})"
+        )
+    parser.add_argument(
+        "--policy", default=d.policy, help=f"the policy whose guides give poses (default {d.policy})"
+    )
+    parser.add_argument(
+        "--workers", type=non_negative_int, default=d.workers, help="generator processes (default 2)"
+    )
+    parser.add_argument(
+        "--steps", type=positive_int, default=d.steps, help="Adam steps of the fit (default: FitConfig's)"
+    )
+    parser.add_argument("--no-mirror", action="store_true", help="do not add the mirrored poses")
+    parser.add_argument(
+        "--weights",
+        default=DEFAULT_WEIGHTS,
+        metavar="FILE.npz",
+        help=f"weights file (default {DEFAULT_WEIGHTS})",
+    )
+    parser.add_argument(
+        "--compare-weights",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="other learned-condition weights to validate on the same poses (a row each; repeatable), "
+        "e.g. the weights a policy was trained with (its run's condition.npz)",
+    )
+    parser.add_argument(
+        "--cost-envs",
+        type=non_negative_int,
+        default=d.cost_envs,
+        help="envs of the cost measurement (0: skip)",
+    )
+    parser.add_argument(
+        "--cost-steps", type=positive_int, default=d.cost_steps, help="env steps per timed call"
+    )
+    parser.add_argument(
+        "--cost-repeats", type=positive_int, default=d.cost_repeats, help="timed calls per condition"
+    )
+    parser.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="folder of the JSON and markdown report (default: the weights' folder)",
+    )
+    parser.add_argument(
+        "--cache", default=d.cache, metavar="DIR", help=f"label cache folder (default {d.cache})"
+    )
+    parser.set_defaults(func=cmd_condition)
+
+
+def _register_walkability(targets) -> None:
+    """Add `walkability`: the options of `walkability.WalkabilityConfig` and the build. The defaults
+    of --out and --held-out (`walkability.WEIGHTS`, `walkability.HELD_OUT`) are read when the
+    command runs: that module imports JAX, which `leas --help` does not."""
+    parser = targets.add_parser(
         "walkability",
         help="build the walkability model of rough ground (data, fit, report)",
         description="Draw terrains of the procedural families, label plausible root poses on them with "
         "the contact generator's walking truth (cached in --cache, resumable), fit the network on the "
-        "training families and report sensitivity and specificity (95 %% intervals) on unseen terrains "
+        "training families and report sensitivity and specificity (95 % intervals) on unseen terrains "
         "of those families, on the held-out families and on --scenes, against the calibrated cylinders.",
     )
     parser.add_argument(
-        "--out", default=WEIGHTS, metavar="WEIGHTS.npz", help=f"weights file (default {WEIGHTS})"
+        "--out", default=None, metavar="WEIGHTS.npz", help="weights file (default: the shipped model's)"
     )
     parser.add_argument(
         "--held-out",
-        default=",".join(HELD_OUT),
+        default=None,
         metavar="LIST",
-        help=f"families kept out of the fit (default {','.join(HELD_OUT)})",
+        help="families kept out of the fit, comma-separated (default: the shipped model's)",
     )
     parser.add_argument(
         "--terrains-per-family", type=positive_int, default=6, help="fitting terrains (default 6)"

@@ -1,6 +1,6 @@
 """Fitting the learned feasibility condition (`leas_jax.env.learned_feasibility`) to labelled poses.
 
-The labels are the contact generator's verdicts (benchmarks/feasibility_condition.py: the
+The labels are the contact generator's verdicts (`leas feasibility condition`: the
 walking truth; `leas_jax.training.planner.verdict_samples`: the poses of the policy's own
 guides during planner-in-the-loop training). Fitting is full-batch Adam on the class-balanced
 binary cross-entropy (the data sets hold a few thousand to a few tens of thousands of poses,
@@ -23,12 +23,12 @@ from leas_jax.env import learned_feasibility as lf
 from leas_jax.env.config import ReachabilityConfig
 from leas_jax.env.field import Heightfield
 
-TARGET_SENSITIVITY = 0.95  # the cylinders' calibration target (benchmarks/reachability_calibration.py)
+TARGET_SENSITIVITY = 0.95  # the cylinders' calibration target (studies/reachability_calibration.py)
 
 
 @dataclass(frozen=True)
 class FitConfig:
-    """Settings of one fit. Defaults measured with benchmarks/feasibility_condition.py (its README)."""
+    """Settings of one fit. Defaults measured with `leas feasibility condition` (docs/results/2026-12-01-feasibility)."""
 
     hidden: tuple = (64, 32)  # tanh MLP widths
     # Full-batch Adam steps from random weights, and the decoupled weight decay (AdamW). Trained

@@ -5,8 +5,8 @@ computed chunk by chunk and the cache file is rewritten (atomically) after each 
 interrupted build resumes after its last finished chunk. A file is reused only for the same
 poses under the same key (a hash of everything the labels depend on, made by the caller),
 else rebuilt. Host only. Used by the generator-verified spawns
-(`leas_jax.feasibility.spawns`) and the learned condition's data
-(`benchmarks/feasibility_data.py`).
+(`leas_jax.feasibility.spawns`) and the data of the learned condition and of the walkability
+model (`walkability.walking_labels`, `leas feasibility`).
 """
 
 from __future__ import annotations

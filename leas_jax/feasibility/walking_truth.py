@@ -3,7 +3,7 @@ key of everything such a label depends on. Host-only.
 
 A pose is feasible when the contact generator covers the short straight guide that starts at
 it along its yaw (`walking_guide`, planned at WALK_TIMESTEP). The learned condition's weights
-(`benchmarks/feasibility_condition.py`) record the `dataset_key` of the labels they were fitted
+(`leas feasibility condition`, `condition_build`) record the `dataset_key` of the labels they were fitted
 on; `stale_weights` compares it with the key the current generator gives, so that a run about to
 train with weights fitted on another generator's verdicts says so.
 """
@@ -21,7 +21,7 @@ from leas_jax.feasibility.spawns import GENERATOR_SOURCES, generator_code_digest
 WALK_POSES = 21  # guide poses 0.018 m apart (0.36 m in 2 s: two or three footsteps)
 WALK_SPEED = 0.18  # m/s, the target speed (paper §IV)
 WALK_TIMESTEP = 0.1  # s, paper Table I
-RELABEL_COMMAND = "python benchmarks/feasibility_condition.py --workers 2"
+RELABEL_COMMAND = "leas feasibility condition --workers 2"
 _REPO = Path(__file__).resolve().parents[2]
 
 
@@ -65,7 +65,7 @@ def stale_weights(path: Path, metadata: dict, generator_config=None) -> str | No
         path: the weights file (for the message).
         metadata: its metadata (`learned_weights.load_params`): `data_key` and `terrain`, the
             labels' key and terrain file (relative to the repository root), as
-            `benchmarks/feasibility_condition.py` writes them. Weights without them (the
+            `leas feasibility condition` writes them. Weights without them (the
             planner phase's refits, hand-made weights) cannot be checked: None.
         generator_config: the generator to compare with (None: `GeneratorConfig()`, the one
             the labels are made with).

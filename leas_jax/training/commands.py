@@ -91,7 +91,7 @@ def add_training_arguments(parser) -> None:
         metavar="FILE",
         default=None,
         help="with --reachability learned: the learned condition's weights (default "
-        "checkpoints/feasibility/walking.npz; benchmarks/condition_from_paths.py refits them on the "
+        "checkpoints/feasibility/walking.npz; studies/condition_from_paths.py refits them on the "
         "generator's whole-path verdicts)",
     )
     parser.add_argument(
@@ -109,7 +109,7 @@ def add_training_arguments(parser) -> None:
         default=None,
         help="with --mode planner --reachability learned: labelled poses (.npz of poses [K, 4] and "
         "labels [K]) that every refresh of the condition also fits, e.g. the path_verdicts.npz of "
-        "benchmarks/condition_from_paths.py or an earlier run's condition_data.npz",
+        "studies/condition_from_paths.py or an earlier run's condition_data.npz",
     )
     parser.add_argument(
         "--condition-refresh-every",

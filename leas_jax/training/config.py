@@ -58,7 +58,7 @@ def learned_condition_env(env: EnvConfig, weights: str = EnvConfig.learned_weigh
     """`env` terminating on the learned feasibility condition (`leas_jax.env.learned_feasibility`,
     weights `weights`) instead of its cylinders. Its reachability becomes the calibrated
     ReachabilityConfig(): the shipped weights read those cylinders' margins (the field needs
-    their rasters; benchmarks/feasibility_condition.py fits them so)."""
+    their rasters; `leas feasibility condition` fits them so)."""
     return dataclasses.replace(
         env, condition="learned", learned_weights=weights, reachability=ReachabilityConfig()
     )
@@ -127,7 +127,7 @@ class TrainConfig:
     condition_anchor_poses: int = 0
     # An .npz of labelled poses (`poses` [K, 4] (x, y, z, yaw), world; `labels` [K] bool) that
     # every refit also fits, the DAgger loop's aggregated data carried from elsewhere: the
-    # generator's verdicts on another policy's whole guides (benchmarks/condition_from_paths.py's
+    # generator's verdicts on another policy's whole guides (studies/condition_from_paths.py's
     # path_verdicts.npz) or an earlier run's condition_data.npz. "": none. Seeded with the
     # cylinders policy's verdicts, the paper preset's DAgger phase kept eval_stairs and
     # eval_stairs_side at 36.7 and 46.7 % success (0 and 0 % without); its policy still stops

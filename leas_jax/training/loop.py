@@ -322,7 +322,7 @@ def _run_condition_env(run_dir: Path, env):
 
     A run trains with the condition it started with (its copy, `_pin_condition`) or the one its
     planner phase last refreshed, not whatever `env.learned_weights` names today: a relabelled
-    default (`benchmarks/feasibility_condition.py`) neither changes a resumed run nor the
+    default (`leas feasibility condition`) neither changes a resumed run nor the
     environment its policy is evaluated in.
     """
     pinned = run_dir / RUN_CONDITION

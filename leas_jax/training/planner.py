@@ -270,7 +270,7 @@ def guides_of(episodes: EpisodeBatch) -> list[np.ndarray]:
     return [np.asarray(poses[n, : lengths[n]], np.float64) for n in range(len(lengths))]
 
 
-# The walking truth the learned condition is fitted on (benchmarks/reachability_calibration.py)
+# The walking truth the learned condition is fitted on (studies/reachability_calibration.py)
 # calls a pose feasible when the generator covers the 0.36 m guide from it: 20 steps at the
 # target speed and timestep. A covered guide pose is labelled feasible only when the guide
 # went on covered for that long after it (or was covered to its end).

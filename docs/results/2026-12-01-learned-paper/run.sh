@@ -13,7 +13,7 @@ PYTHONPATH=$PWD python benchmarks/train_throughput.py --presets paper --conditio
 for label in learned cylinders; do
   if [ $label = learned ]; then P=$LEARNED; else P=$CYLINDERS; fi
   for spawns in condition generator; do
-    PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $P --starts 256 --workers 2 \
+    PYTHONPATH=$PWD python studies/guide_failures.py --policy $P --starts 256 --workers 2 \
       --spawns $spawns --out $D/guides/$label/$spawns
   done
 done
@@ -26,7 +26,7 @@ leas arena-check --checkpoint $LEARNED --episodes 1024 --out $D/arena_check
 #   --out runs/paper_learned_planner --no-progress
 PLANNER=$D/train_paper_learned_planner
 for spawns in condition generator; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $PLANNER --starts 256 --workers 2 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy $PLANNER --starts 256 --workers 2 \
     --spawns $spawns --out $D/guides/learned_planner/$spawns
 done
 leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $PLANNER \
@@ -35,17 +35,17 @@ leas arena-check --checkpoint $PLANNER --episodes 1024 --out $D/arena_check_plan
 # which of the cylinders policy's successful scenario guides would each learned condition end?
 leas evaluate --scenario bridge,stairs,stairs_side --methods leas --checkpoint $CYLINDERS \
   --workers 2 --no-progress --out /tmp/cylinders_eval
-PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+PYTHONPATH=$PWD python studies/condition_on_guides.py --evaluation /tmp/cylinders_eval \
   --policy $LEARNED --out $D/condition_on_guides
-PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+PYTHONPATH=$PWD python studies/condition_on_guides.py --evaluation /tmp/cylinders_eval \
   --policy $PLANNER --out $D/condition_on_guides_planner
 # the same planner phase with every refit anchored on 4000 reset-like poses labelled by the
 # starting condition (TrainConfig.condition_anchor_poses); kept in $D/train_paper_learned_anchored
 # PYTHONPATH=$PWD python $D/train_anchored.py runs/paper_learned runs/paper_learned_anchored
 ANCHORED=$D/train_paper_learned_anchored
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $ANCHORED --starts 256 --workers 2 \
+PYTHONPATH=$PWD python studies/guide_failures.py --policy $ANCHORED --starts 256 --workers 2 \
   --spawns condition --out $D/guides/learned_anchored/condition
 leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $ANCHORED \
   --workers 2 --no-progress --out $D/evaluate_anchored
-PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+PYTHONPATH=$PWD python studies/condition_on_guides.py --evaluation /tmp/cylinders_eval \
   --policy $ANCHORED --out $D/condition_on_guides_anchored

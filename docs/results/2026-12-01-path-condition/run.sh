@@ -8,11 +8,11 @@ CYLINDERS=checkpoints/leas_talos/pretrain   # the teacher: the paper preset with
 LEARNED=docs/results/2026-12-01-learned-paper/train_paper_learned   # the same preset with checkpoints/feasibility/walking.npz
 # the refit, per-pose threshold (95 % sensitivity on the poses kept aside), with its trade-off table;
 # the planned teacher guides (13 MB) are kept in $D/refit_per_pose/teacher_guides_0.npz and reused
-PYTHONPATH=$PWD python benchmarks/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
+PYTHONPATH=$PWD python studies/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
   --weights-out $D/train_paper_paths/condition.npz --out $D/refit_per_pose
 # the same refit, threshold for 80 % of the fitted guides' surely feasible prefixes passing whole
 mkdir -p $D/refit_path80 && cp $D/refit_per_pose/teacher_guides_0.npz $D/refit_path80/
-PYTHONPATH=$PWD python benchmarks/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
+PYTHONPATH=$PWD python studies/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
   --path-sensitivity 0.8 --weights-out $D/train_paper_paths80/condition.npz --out $D/refit_path80
 cp $D/refit_per_pose/teacher_guides_0.npz /tmp/teacher_guides_0.npz   # reused by the second round below
 rm $D/refit_per_pose/teacher_guides_0.npz $D/refit_path80/teacher_guides_0.npz
@@ -27,14 +27,14 @@ leas evaluate --scenario bridge,stairs,stairs_side --methods leas --checkpoint $
   --workers 2 --no-progress --out /tmp/cylinders_eval
 for run in paths paths80; do
   P=$D/train_paper_$run
-  PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+  PYTHONPATH=$PWD python studies/condition_on_guides.py --evaluation /tmp/cylinders_eval \
     --policy $P --out $D/condition_on_guides_$run
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $P --starts 256 --workers 2 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy $P --starts 256 --workers 2 \
     --spawns condition --out $D/guides/$run/condition
   leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $P \
     --workers 2 --no-progress --out $D/evaluate_$run
 done
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $D/train_paper_paths --starts 256 --workers 2 \
+PYTHONPATH=$PWD python studies/guide_failures.py --policy $D/train_paper_paths --starts 256 --workers 2 \
   --spawns generator --out $D/guides/paths/generator
 leas arena-check --checkpoint $D/train_paper_paths --episodes 1024 --out $D/arena_check
 # the pillar check terrain: the straight guide, then each policy
@@ -48,11 +48,11 @@ done
 # leas train --mode planner --preset paper --init runs/paper_learned --reachability learned \
 #   --condition-seed-data $D/refit_per_pose/path_verdicts.npz --workers 2 --out runs/paper_learned_seeded --no-progress
 SEEDED=$D/train_paper_learned_seeded
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $SEEDED --starts 256 --workers 2 \
+PYTHONPATH=$PWD python studies/guide_failures.py --policy $SEEDED --starts 256 --workers 2 \
   --spawns condition --out $D/guides/learned_seeded/condition
 leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $SEEDED \
   --workers 2 --no-progress --out $D/evaluate_learned_seeded
-PYTHONPATH=$PWD python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+PYTHONPATH=$PWD python studies/condition_on_guides.py --evaluation /tmp/cylinders_eval \
   --policy $SEEDED --out $D/condition_on_guides_learned_seeded
 leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint $SEEDED --workers 2 \
   --no-progress --out $D/pillars/train_paper_learned_seeded
@@ -60,7 +60,7 @@ leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint
 # leas train --preset paper --reachability learned --condition-weights $SEEDED/condition.npz \
 #   --out runs/paper_seeded_geometric --no-progress
 AGAIN=$D/train_paper_seeded_geometric
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $AGAIN --starts 256 --workers 2 \
+PYTHONPATH=$PWD python studies/guide_failures.py --policy $AGAIN --starts 256 --workers 2 \
   --spawns condition --out $D/guides/seeded_geometric/condition
 leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $AGAIN \
   --workers 2 --no-progress --out $D/evaluate_seeded_geometric
@@ -69,7 +69,7 @@ leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint
 leas arena-check --checkpoint $AGAIN --episodes 1024 --out $D/arena_check_seeded_geometric
 # a second outer round, refit only: the retrained policy's verdicts with the teacher's
 mkdir -p $D/refit_round2 && cp /tmp/teacher_guides_0.npz $D/refit_round2/teacher_guides_1.npz
-PYTHONPATH=$PWD python benchmarks/condition_from_paths.py --teacher $AGAIN $CYLINDERS \
+PYTHONPATH=$PWD python studies/condition_from_paths.py --teacher $AGAIN $CYLINDERS \
   --weights $SEEDED/condition.npz --episodes 1024 --holdout 256 --workers 2 \
   --weights-out /tmp/round2_condition.npz --out $D/refit_round2
 rm $D/refit_round2/teacher_guides_*.npz $D/refit_round2/path_verdicts.npz

@@ -9,9 +9,9 @@ D=docs/results/2026-12-02-ablation
 
 # 1. The learned condition on the current generator's walking truth: labels cached in .cache/
 #    (24 000 poses, about 3 min), fit, validation, cost per env step; writes the shipped weights.
-PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/feasibility
+leas feasibility condition --workers 2 --out $D/feasibility
 
 # 2. The study (about 2 h: 6 geometric runs of 7-9 min, 6 planner phases, 12 evaluations).
-PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out $D/study --preset quick --seeds 0,1,2 \
+PYTHONPATH=$PWD python studies/feasibility_study.py --out $D/study --preset quick --seeds 0,1,2 \
   --eval-seeds 0 --starts 256 --scenarios bridge stairs stairs_side circuit --scenario-starts 20 \
   --workers 2

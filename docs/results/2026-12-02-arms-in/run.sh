@@ -9,7 +9,7 @@ D=docs/results/2026-12-02-arms-in
 
 # 1. The shipped policy's own arena guides, rigid upper body then arms held in (4 min).
 for UB in half_sitting half_sitting,arms_in; do
-  python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
+  python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
     --spawns condition --upper-bodies $UB --out $D/shipped/$UB
 done
 
@@ -19,7 +19,7 @@ for PAIR in pretrain:checkpoints/leas_talos/pretrain \
     learned:docs/results/2026-12-01-learned-paper/train_paper_learned \
     learned_seeded:docs/results/2026-12-01-path-condition/train_paper_learned_seeded \
     seeded_geometric:docs/results/2026-12-01-path-condition/train_paper_seeded_geometric; do
-  python benchmarks/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
+  python studies/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
     --spawns condition --out $D/${PAIR%%:*}
 done
 
@@ -40,7 +40,7 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
 # 5. The learned condition relabelled and refitted on the new generator's walking truth
 #    (the label cache's key holds the generator's settings, so every pose is labelled again:
 #    24 000 poses, 3 min with 2 workers on the idle machine).
-PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 \
+leas feasibility condition --workers 2 \
   --weights $D/walking_arms_in.npz --out $D/feasibility
 
 # 6. The paper preset trained with the relabelled condition, seeds 0-2 (21 min each), and
@@ -50,7 +50,7 @@ for S in 0 1 2; do
     --out runs/paper_learned_arms_s$S --no-progress
   T=$D/train_paper_learned_arms_s$S
   mkdir -p $T && cp runs/paper_learned_arms_s$S/config.json runs/paper_learned_arms_s$S/policy.ckpt $T/
-  python benchmarks/guide_failures.py --policy $T --starts 256 --workers 2 --spawns condition \
+  python studies/guide_failures.py --policy $T --starts 256 --workers 2 --spawns condition \
     --out $D/learned_arms_s$S
   leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods leas --checkpoint $T \
     --workers 2 --no-progress --out $D/evaluate_learned_arms_s$S
@@ -60,15 +60,15 @@ for S in 0 1 2; do
 done
 
 # 7. The shipped policy's failed guides re-planned with other generator settings (3 min).
-python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
+python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
   --spawns condition --what-if --out $D/shipped/what_if
 
 # 7b. The same with resets at generator-verified poses (the spawns' verdicts rebuilt once, 2.5 min).
-python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
+python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
   --spawns generator --out $D/shipped/verified_spawns
 
 # 8. `make run` from a fresh clone (8 min with the environment installed), then its
 #    fine-tuned policy's own arena guides (run from the clone's root, where runs/quick is).
 #   time make run
-#   python benchmarks/guide_failures.py --policy runs/quick/planner --starts 256 --workers 2 \
+#   python studies/guide_failures.py --policy runs/quick/planner --starts 256 --workers 2 \
 #     --spawns condition --out $D/make_run/own_guides

@@ -37,8 +37,8 @@ PYTHONPATH=$PWD python benchmarks/train_throughput.py --presets paper --conditio
 
 # The shipped policy's own arena guides (evaluation seed 0) after the change, paired with the
 # same run before it (docs/results/2026-12-02-retry-settings), 3 min.
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
+PYTHONPATH=$PWD python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 --workers 2 \
   --spawns condition --seed 0 --out $D/guides_shipped_seed0
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --compare \
+PYTHONPATH=$PWD python studies/guide_failures.py --compare \
   docs/results/2026-12-02-retry-settings/guides/shipped/seed0/guide_failures.json \
   $D/guides_shipped_seed0/guide_failures.json --out $D/guides_shipped_seed0

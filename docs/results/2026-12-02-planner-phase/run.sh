@@ -15,7 +15,7 @@ for S in ${SEEDS:-0 1 2}; do
   leas train --mode planner --preset paper --init checkpoints/leas_talos/pretrain --timesteps 150000 \
     --seed $S --workers 2 --no-progress --out $R/seed$S
   mkdir -p $D/seed$S && cp $R/seed$S/metrics.jsonl $R/seed$S/config.json $D/seed$S/
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy $R/seed$S --starts 256 --workers 2 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy $R/seed$S --starts 256 --workers 2 \
     --spawns condition --seed 0 --out $D/seed$S/guides
 done
 python $D/summarise.py $D > $D/summary.md

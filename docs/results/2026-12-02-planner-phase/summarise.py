@@ -1,6 +1,6 @@
 """Table of run.sh: each planner-phase seed's own arena guides against its pretrain's and the
 shipped policy's (same starts: evaluation seed 0, 256 starts), with the seeds pooled by a
-two-level bootstrap (seeds, then starts) as benchmarks/feasibility_study.py does.
+two-level bootstrap (seeds, then starts) as studies/feasibility_study.py does.
 
     python docs/results/2026-12-02-planner-phase/summarise.py docs/results/2026-12-02-planner-phase
 """
@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[3]
-sys.path.insert(0, str(REPO / "benchmarks"))
+sys.path[:0] = [str(REPO / "studies"), str(REPO / "benchmarks")]
 from feasibility_study import bootstrap_interval  # noqa: E402
 
 REFERENCES = {

@@ -10,15 +10,15 @@ D=docs/results/2026-12-02-refined-planning-poses
 B=docs/results/2026-12-02-stance-arm-shifts
 
 # 1. Table II's RBKino and RBLin, 60 starts per cell (1 min).
-PYTHONPATH=$PWD python benchmarks/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
+PYTHONPATH=$PWD python studies/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
   --variants rblin,rbkino --sweep-steps ""
 
 # 2. Own arena guides, 256 starts, evaluation seed 0 (2 min each on the idle machine), paired.
 for PAIR in shipped:checkpoints/leas_talos pretrain:checkpoints/leas_talos/pretrain \
     learned_arms_s0:docs/results/2026-12-02-arms-in/train_paper_learned_arms_s0; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
     --spawns condition --out $D/guides/${PAIR%%:*}
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --compare $B/guides/${PAIR%%:*}/guide_failures.json \
+  PYTHONPATH=$PWD python studies/guide_failures.py --compare $B/guides/${PAIR%%:*}/guide_failures.json \
     $D/guides/${PAIR%%:*}/guide_failures.json --out $D/guides/${PAIR%%:*}
 done
 
@@ -31,11 +31,11 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
 # 4. The day's three generator changes together: paired with docs/results/2026-12-02-step-fallback.
 for P in shipped pretrain learned_arms_s0; do
   mkdir -p $D/guides/$P/since_step_fallback
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py \
+  PYTHONPATH=$PWD python studies/guide_failures.py \
     --compare docs/results/2026-12-02-step-fallback/guides/$P/guide_failures.json \
     $D/guides/$P/guide_failures.json --out $D/guides/$P/since_step_fallback
 done
 
 # 5. The learned condition relabelled on this generator's walking truth (labels cached in
 #    .cache/, 24 000 poses), fitted and validated; writes checkpoints/feasibility/walking.npz.
-PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/feasibility
+leas feasibility condition --workers 2 --out $D/feasibility

@@ -11,8 +11,8 @@ export PATH="$PWD/.venv/bin:$PATH"
 D=docs/results/2026-12-02-retry-settings
 B=docs/results/2026-12-02-refined-planning-poses
 BEFORE="--set max_foot_offset=0.25 --set max_single_support_offset_xy=0.20 --set candidate_radius=0.15 --set max_candidates=12 --set retry_settings=()"
-g() { PYTHONPATH=$PWD python benchmarks/guide_failures.py --starts 256 --workers 2 --spawns condition "$@"; }
-c() { PYTHONPATH=$PWD python benchmarks/guide_failures.py --compare "$@"; }
+g() { PYTHONPATH=$PWD python studies/guide_failures.py --starts 256 --workers 2 --spawns condition "$@"; }
+c() { PYTHONPATH=$PWD python studies/guide_failures.py --compare "$@"; }
 
 # 1. Own arena guides, 256 starts (2-3 min each on the idle machine). Evaluation seed 0 pairs
 #    with the report of the generator before ($B); seed 1 runs both generators here.
@@ -39,7 +39,7 @@ leas evaluate --terrain terrains/checks/pillars.toml --methods leas --checkpoint
   --workers 2 --no-progress --out $D/pillars
 leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --no-progress \
   --out $D/evaluate_shipped
-PYTHONPATH=$PWD python benchmarks/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
+PYTHONPATH=$PWD python studies/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
   --variants rblin,rbkino --sweep-steps ""
 
 #    The shipped policy's eval_ground speed and arena safety (10 s).
@@ -47,12 +47,12 @@ leas arena-check --checkpoint checkpoints/leas_talos --out $D/arena_check_shippe
 
 # 4. The learned condition relabelled on this generator's walking truth (labels cached in
 #    .cache/, 24 000 poses), fitted and validated; writes checkpoints/feasibility/walking.npz.
-PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/feasibility
+leas feasibility condition --workers 2 --out $D/feasibility
 
 # 5. `make run` from a fresh clone of this commit (outside the repository, here /tmp/mr), then
 #    its planner-phase policy's own arena guides on two evaluation seeds:
 #      git clone . /tmp/mr && (cd /tmp/mr && time make run)
-#      for S in 0 1; do PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy /tmp/mr/runs/quick/planner \
+#      for S in 0 1; do PYTHONPATH=$PWD python studies/guide_failures.py --policy /tmp/mr/runs/quick/planner \
 #        --starts 256 --workers 2 --spawns condition --seed $S --out $D/make_run/guides_seed$S; done
 #    and runs/quick/report.md with its figures copied into $D/make_run/.
 
@@ -62,7 +62,7 @@ PYTHONPATH=$PWD python benchmarks/feasibility_condition.py --workers 2 --out $D/
 #    their episodes with the weights at their stored path, i.e. step 4's relabelled ones.
 rm -rf /tmp/study && mkdir -p /tmp/study/runs
 cp -r docs/results/2026-12-02-ablation/study/runs/cylinders docs/results/2026-12-02-ablation/study/runs/learned /tmp/study/runs/
-PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out /tmp/study --methods cylinders,learned \
+PYTHONPATH=$PWD python studies/feasibility_study.py --out /tmp/study --methods cylinders,learned \
   --seeds 0,1,2 --eval-seeds 0,1 --starts 256 --workers 2
 mkdir -p $D/study && cp /tmp/study/feasibility_study.json /tmp/study/feasibility_study.md /tmp/study/feasibility_study.png $D/study/
 

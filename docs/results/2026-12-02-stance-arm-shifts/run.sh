@@ -11,7 +11,7 @@ D=docs/results/2026-12-02-stance-arm-shifts
 # 1. Own arena guides, 256 starts, evaluation seed 0 (2 min each on the idle machine).
 for PAIR in shipped:checkpoints/leas_talos pretrain:checkpoints/leas_talos/pretrain \
     learned_arms_s0:docs/results/2026-12-02-arms-in/train_paper_learned_arms_s0; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
     --spawns condition --out $D/guides/${PAIR%%:*}
 done
 
@@ -24,12 +24,12 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
   --out $D/evaluate_shipped
 
 # 4. Table II's RBKino and RBLin, 60 starts per cell (1 min).
-PYTHONPATH=$PWD python benchmarks/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
+PYTHONPATH=$PWD python studies/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
   --variants rblin,rbkino --sweep-steps ""
 
 # 5. Each policy's guides paired with the step-fallback generator's verdicts on the same episodes.
 for P in shipped pretrain learned_arms_s0; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py \
+  PYTHONPATH=$PWD python studies/guide_failures.py \
     --compare docs/results/2026-12-02-step-fallback/guides/$P/guide_failures.json \
     $D/guides/$P/guide_failures.json --out $D/guides/$P
 done

@@ -14,12 +14,12 @@ for PAIR in shipped:checkpoints/leas_talos pretrain:checkpoints/leas_talos/pretr
     learned:docs/results/2026-12-01-learned-paper/train_paper_learned \
     learned_arms_s0:docs/results/2026-12-02-arms-in/train_paper_learned_arms_s0 \
     learned_seeded:docs/results/2026-12-01-path-condition/train_paper_learned_seeded; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy ${PAIR#*:} --starts 256 --workers 2 \
     --spawns condition --out $D/guides/${PAIR%%:*}
 done
 # 1b. The shipped policy from generator-verified resets (the spawn verdicts are cached by
 #     the generator's settings and code: 59 286 poses labelled again, about 10 min, once).
-PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
+PYTHONPATH=$PWD python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
   --workers 2 --spawns generator --out $D/guides/shipped_verified_spawns
 
 # 2. The pillar check (15 s per policy).
@@ -34,5 +34,5 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
   --out $D/evaluate_shipped
 
 # 4. Table II's RBKino, 60 starts per cell (1 min).
-PYTHONPATH=$PWD python benchmarks/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
+PYTHONPATH=$PWD python studies/table2_baselines.py --out $D/table2 --n-starts 60 --workers 2 \
   --variants rblin,rbkino --sweep-steps ""

@@ -16,6 +16,6 @@ case "$1" in
 esac
 mkdir -p $OUT/runs
 ln -sfn ../../study/runs/learned $OUT/runs/learned
-PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out $OUT --methods learned+planner $REFITS \
+PYTHONPATH=$PWD python studies/feasibility_study.py --out $OUT --methods learned+planner $REFITS \
   --preset quick --seeds ${SEEDS:-0,1,2} --eval-seeds 0,1 --starts 256 \
   --scenarios hole bridge stairs stairs_side circuit --scenario-starts 20 --workers 2

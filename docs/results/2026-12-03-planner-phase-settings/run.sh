@@ -25,7 +25,7 @@ case "$1" in
   *) echo "usage: sh $0 length|minibatches" >&2; exit 2 ;;
 esac
 judge() {  # judge POLICY OUT: the policy's own arena guides, evaluation seed 0, 256 starts
-  [ -f "$2/guide_failures.json" ] || PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy "$1" \
+  [ -f "$2/guide_failures.json" ] || PYTHONPATH=$PWD python studies/guide_failures.py --policy "$1" \
     --starts 256 --workers 2 --spawns condition --seed 0 --out "$2"
 }
 for S in ${SEEDS:-0 1 2}; do

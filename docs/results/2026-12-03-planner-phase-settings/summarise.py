@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[3]
-sys.path.insert(0, str(REPO / "benchmarks"))
+sys.path[:0] = [str(REPO / "studies"), str(REPO / "benchmarks")]
 from feasibility_study import bootstrap_interval  # noqa: E402
 
 SHORT_PHASE = REPO / "docs/results/2026-12-02-planner-phase"

@@ -8,6 +8,6 @@
 # every run (seeds outer, methods inner).
 set -e
 export PATH="$PWD/.venv/bin:$PATH"
-PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out docs/results/2026-12-04-ablation-more-seeds/study \
+PYTHONPATH=$PWD python studies/feasibility_study.py --out docs/results/2026-12-04-ablation-more-seeds/study \
   --preset quick --seeds 3,4,5 --methods cylinders,learned --eval-seeds 0,1 --starts 256 \
   --scenarios hole bridge stairs stairs_side circuit --scenario-starts 20 --workers 2

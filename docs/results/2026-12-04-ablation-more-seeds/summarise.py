@@ -17,7 +17,7 @@ from scipy.stats import fisher_exact
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
-sys.path.insert(0, str(REPO / "benchmarks"))
+sys.path[:0] = [str(REPO / "studies"), str(REPO / "benchmarks")]
 from feasibility_study import bootstrap_interval  # noqa: E402
 
 STUDIES = (REPO / "docs/results/2026-12-03-ablation/study", HERE / "study")

@@ -9,7 +9,7 @@
 set -e
 export PATH="$PWD/.venv/bin:$PATH"
 D=docs/results/2026-12-04-learned-clearance
-PYTHONPATH=$PWD python benchmarks/feasibility_study.py --out $D/study --preset quick --seeds 0,1,2 \
+PYTHONPATH=$PWD python studies/feasibility_study.py --out $D/study --preset quick --seeds 0,1,2 \
   --eval-seeds 0,1 --starts 256 --scenarios hole bridge stairs stairs_side circuit --scenario-starts 20 \
   --workers 2 --methods learned --clearance-condition cylinders
 python benchmarks/train_throughput.py --presets quick,paper --conditions cylinders,learned \

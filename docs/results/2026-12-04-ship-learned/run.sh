@@ -11,7 +11,7 @@ set -e
 export PATH="$PWD/.venv/bin:$PATH"
 D=docs/results/2026-12-04-ship-learned
 R=runs/shipped-learned
-g() { PYTHONPATH=$PWD python benchmarks/guide_failures.py --starts 256 --workers 2 --spawns condition "$@"; }
+g() { PYTHONPATH=$PWD python studies/guide_failures.py --starts 256 --workers 2 --spawns condition "$@"; }
 
 # 1. The `paper` preset with the learned condition: 80 M geometric steps, then 600 k kept steps
 #    of planner-in-the-loop fine-tuning (about 35 min).

@@ -9,7 +9,7 @@ D=docs/results/2026-12-05-higher-swing-retries
 # The 6 default retries, then the two tried here (not the default: see README.md).
 RETRIES='((("lookahead", 0.9),), (("candidate_radius", 0.40), ("max_candidates", 48)), (("max_foot_offset", 0.40),), (("lookahead", 0.5),), (("step_trigger", 0.05),), (("swing_lift", 0.03),), (("swing_lift", 0.15),), (("lookahead", 1.1),))'
 for S in 0 1 2 3; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
     --workers 2 --spawns condition --seed $S --out $D/guides/seed$S --set "retry_settings=$RETRIES"
 done
 # The same policy's guides before were judged as runs/shipped-learned, its training folder, so

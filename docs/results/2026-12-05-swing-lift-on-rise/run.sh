@@ -9,7 +9,7 @@ set -e
 export PATH="$PWD/.venv/bin:$PATH"
 D=docs/results/2026-12-05-swing-lift-on-rise
 for S in 0 1 2 3; do
-  PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
+  PYTHONPATH=$PWD python studies/guide_failures.py --policy checkpoints/leas_talos --starts 256 \
     --workers 2 --spawns condition --seed $S --out $D/guides/seed$S
 done
 python $D/summarise.py > $D/summary.md
@@ -22,6 +22,6 @@ leas evaluate --checkpoint checkpoints/leas_talos --scenario all --workers 2 --n
 # `make run` from a fresh clone of this commit outside the repository, then its planner-phase
 # policy's own arena guides (evaluation seeds 0-3):
 #   git clone . /tmp/mr && (cd /tmp/mr && time make run)
-#   for S in 0 1 2 3; do PYTHONPATH=$PWD python benchmarks/guide_failures.py --policy /tmp/mr/runs/quick/planner \
+#   for S in 0 1 2 3; do PYTHONPATH=$PWD python studies/guide_failures.py --policy /tmp/mr/runs/quick/planner \
 #     --starts 256 --workers 2 --spawns condition --seed $S --out $D/make_run/guides_seed$S; done
 # and runs/quick/report.md with its figures copied into $D/make_run/.

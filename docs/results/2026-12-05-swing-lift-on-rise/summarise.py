@@ -18,7 +18,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
-sys.path.insert(0, str(REPO / "benchmarks"))
+sys.path[:0] = [str(REPO / "studies"), str(REPO / "benchmarks")]
 from common import wilson  # noqa: E402
 from guide_failures import sign_test  # noqa: E402
 

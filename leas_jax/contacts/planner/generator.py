@@ -297,7 +297,7 @@ def double_support_posture(
 
     Host-only, not jittable. What the generator does for the first posture of a plan
     (`ContactGenerator.double_support`); the ground truth the reachability condition
-    is calibrated against (benchmarks/reachability_calibration.py). Reuses the
+    is calibrated against (studies/reachability_calibration.py). Reuses the
     process's generator like `plan_contacts`.
 
     Args:

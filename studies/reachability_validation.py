@@ -1,6 +1,6 @@
-"""Check the calibrated reachability condition on fresh poses, and how far a richer one could go.
+"""Does the calibrated reachability condition hold on fresh poses, and how far could a richer one go?
 
-benchmarks/reachability_calibration.py fits the condition's parameters to 48 000 poses
+studies/reachability_calibration.py fits the condition's parameters to 48 000 poses
 of terrains/training_arena.toml (seed 0) and reports them on a held-out third. This
 script draws an independent set (`--poses`, default 36 000, `--seed`, default 1; same
 sampler, `reachability_calibration.sample_poses`), computes the contact generator's
@@ -24,10 +24,12 @@ ground truth there (cached in .cache/ like the calibration's), and reports:
    (`--train-sizes`): whether the cylinders' gap is one of information (the heightfield
    near the root does not tell) or of form (the cylinders cannot express what it tells).
 
-    python benchmarks/reachability_validation.py [--poses 36000] [--truth static walking]
+    python studies/reachability_validation.py [--poses 36000] [--truth static walking]
         [--learned] [--calibration-json docs/results/.../reachability_calibration.json] [--reuse]
 
 Writes <out>/reachability_validation.json.
+
+Results: docs/results/2026-11-22-reachability-48000-poses.
 """
 
 from __future__ import annotations
@@ -46,28 +48,21 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 import reachability_calibration as rc  # noqa: E402
-from common import wilson  # noqa: E402
+
+from leas_jax.feasibility.poses import ARENA, cylinder_verdicts, sample_poses  # noqa: E402
+from leas_jax.stats import rates  # noqa: E402
 
 TARGET_SENSITIVITY = rc.TARGET_SENSITIVITY
 HEIGHTMAP_STEP = 0.04  # m, spacing of the learned reference's heightmap
 HEIGHTMAP_X = (-0.40, 0.60)  # m, root frame: behind the heels to past the lookahead legs (+0.30 m)
 HEIGHTMAP_Y = (-0.64, 0.64)  # m, root frame: past the hand disks (0.45 + 0.13 m)
 HEIGHTMAP_CLIP = (-1.6, 0.4)  # m, heights relative to the root (the void is -2 m below the arena)
-CALIBRATION_SEED = 0  # benchmarks/reachability_calibration.py's default --seed
+CALIBRATION_SEED = 0  # studies/reachability_calibration.py's default --seed
 THRESHOLD_SPLIT = 0.1  # share of the fitting poses kept aside to set the classifier's threshold
-
-
-def rates(predicted: np.ndarray, truth: np.ndarray) -> dict:
-    """`reachability_calibration.confusion` plus the Wilson intervals of both rates."""
-    c = rc.confusion(predicted, truth)
-    return {
-        **c,
-        "sensitivity_95ci": wilson(c["tp"], c["tp"] + c["fn"]),
-        "specificity_95ci": wilson(c["tn"], c["tn"] + c["fp"]),
-    }
 
 
 def local_heightmap(
@@ -191,7 +186,7 @@ def main(argv=None) -> None:
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import TRAINING_REACHABILITY
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--poses", type=int, default=36000, help="fresh poses to validate on")
     parser.add_argument("--seed", type=int, default=1, help="their sampler's seed (the calibration uses 0)")
     parser.add_argument("--truth", nargs="+", choices=("static", "walking"), default=["static", "walking"])
@@ -228,7 +223,7 @@ def main(argv=None) -> None:
         if max(sizes) > args.poses:
             parser.error(f"--train-sizes: {max(sizes)} exceeds --poses {args.poses}")
 
-    terrain = load_terrain(rc.ARENA)
+    terrain = load_terrain(ARENA)
     configs = {"defaults": ReachabilityConfig(), "training": TRAINING_REACHABILITY}
     if args.calibration_json:
         path = Path(args.calibration_json)
@@ -237,16 +232,16 @@ def main(argv=None) -> None:
         except (OSError, ValueError, KeyError) as error:
             parser.error(f"--calibration-json {path}: cannot read its chosen_with_hands ({error})")
         configs[f"chosen_with_hands of {path.name}"] = ReachabilityConfig(**chosen)
-    poses = rc.sample_poses(terrain, args.poses, args.seed)
+    poses = sample_poses(terrain, args.poses, args.seed)
     if args.learned:  # the same features for every truth: the fresh poses (shuffled) and the calibration's
         order = np.random.default_rng(args.seed).permutation(len(poses))
         train_x = local_heightmap(terrain, poses[order])
-        test_poses = rc.sample_poses(terrain, args.calibration_poses, CALIBRATION_SEED)
+        test_poses = sample_poses(terrain, args.calibration_poses, CALIBRATION_SEED)
         test_x = local_heightmap(terrain, test_poses)
     report = {
         "poses": args.poses,
         "seed": args.seed,
-        "terrain": f"terrains/{rc.ARENA.name}",
+        "terrain": f"terrains/{ARENA.name}",
         "configs": {name: dataclasses.asdict(cfg) for name, cfg in configs.items()},
         "truths": {},
     }
@@ -260,7 +255,7 @@ def main(argv=None) -> None:
         )
         entry = {"feasible": int(truth.sum()), "ground_truth_seconds": seconds, "validation": {}}
         for name, cfg in configs.items():
-            entry["validation"][name] = rates(rc.condition(terrain, poses, cfg), truth)
+            entry["validation"][name] = rates(cylinder_verdicts(terrain, poses, cfg), truth)
             print(f"  {name:40s} {_fmt(entry['validation'][name])}")
         if args.learned:
             test_truth, _ = rc.cached_ground_truth(

@@ -1,4 +1,5 @@
-"""Navigate on the HPP group's Talos demo queries, each plan verified; optionally on its rough scenes.
+"""Does navigate reach the HPP group's Talos demo queries with a verified plan, and how long does
+each part take? Optionally on its rough scenes too.
 
 Demo queries: every terrain of `--demos` (default terrains/hpp/demos/*.toml), each one
 query of hpp-rbprm-corba's talos_*_path.py scripts (terrains/hpp/README.md): its
@@ -19,10 +20,12 @@ N) to its target, one `Navigator` per scene (its lattice built once). A start su
 when the query is reached and its plan verifies; the success rate comes with its 95 %
 Wilson interval.
 
-    python benchmarks/navigate_demos.py
-    python benchmarks/navigate_demos.py --terrains 'terrains/hpp/rough/*.toml' terrains/hpp/rubble.toml --starts 20
+    python studies/navigate_demos.py
+    python studies/navigate_demos.py --terrains 'terrains/hpp/rough/*.toml' terrains/hpp/rubble.toml --starts 20
 
 Writes <out>/navigate_demos.json.
+
+Results: --out (default benchmarks/results/); a run to keep goes to docs/results/<date-topic>.
 """
 
 from __future__ import annotations
@@ -30,10 +33,13 @@ from __future__ import annotations
 import argparse
 import glob
 import math
+import sys
 import time
 from pathlib import Path
 
-from common import REPO, add_out_argument, load_average, save, wilson
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # benchmarks/common.py
+
+from common import REPO, add_out_argument, load_average, save, wilson  # noqa: E402
 
 DEMOS = "terrains/hpp/demos/*.toml"
 CHECKPOINT = "checkpoints/leas_talos"
@@ -275,7 +281,7 @@ def expand(patterns: list[str]) -> list[Path]:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--demos", nargs="+", default=[DEMOS], metavar="GLOB", help=f"default {DEMOS}")
     parser.add_argument(
         "--terrains", nargs="+", default=[], metavar="GLOB", help="scenes whose scenario starts to run too"

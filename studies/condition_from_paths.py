@@ -1,6 +1,7 @@
-"""Refit the learned feasibility condition on the contact generator's whole-path verdicts.
+"""Does the learned feasibility condition, refitted on the contact generator's whole-path verdicts,
+stop ending the guides the generator covers (beams, stairs)?
 
-The shipped weights (`checkpoints/feasibility/walking.npz`, benchmarks/feasibility_condition.py)
+The shipped weights (`checkpoints/feasibility/walking.npz`, `leas feasibility condition`)
 learned the *walking truth*: a 0.36 m straight guide at the pose's height and yaw. On a
 beam or up a flight of stairs that short level guide often fails where the walk that
 follows the terrain does not, so the condition rejects poses of guides the generator
@@ -30,8 +31,10 @@ a guide at or before the pose the generator could not pass?) and per pose, with 
 Wilson intervals; covered guides' false ends are broken down by arena cell. Writes the
 weights to --weights-out and condition_from_paths.json / .md into --out.
 
-    python benchmarks/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
+    python studies/condition_from_paths.py --episodes 1024 --holdout 256 --workers 2 \
         --weights-out DIR/condition.npz --out DIR
+
+Results: docs/results/2026-12-01-path-condition.
 """
 
 from __future__ import annotations
@@ -45,7 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 PATH_FIT_STEPS = (
     400  # AdamW steps of the refit from the shipped weights (FitConfig.refresh_steps is a DAgger step's 200)
@@ -182,7 +186,7 @@ def plan_teacher_guides(
 def main(argv=None) -> dict:
     from common import add_out_argument, load_average, save, wilson
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--teacher",
         nargs="+",
@@ -220,13 +224,13 @@ def main(argv=None) -> dict:
 
     import jax.numpy as jnp
     from guide_failures import cell_kinds, kind_at
-    from reachability_validation import rates
 
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.env.learned_weights import load_params, save_params
     from leas_jax.feasibility import FitConfig, features_of, fit, predict
     from leas_jax.feasibility.spawns import arena_field
     from leas_jax.files import resolve_data_path
+    from leas_jax.stats import rates
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import learned_condition_env
     from leas_jax.training.planner import VERDICT_HORIZON, anchor_samples, verdict_samples

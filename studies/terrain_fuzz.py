@@ -1,4 +1,6 @@
-"""Seeded fuzzing of the terrain loader: every mutant is loaded, and must either load or raise TerrainError.
+"""Does the terrain loader load or refuse with TerrainError every malformed file, in bounded time?
+
+Seeded fuzzing: every mutant is loaded, and must either load or raise TerrainError.
 
 Mutants are made from the committed terrain files (terrains/*.toml, tests/data/*.toml) by one to
 three seeded text mutations each: a number replaced by an extreme one (5e-324, +-1e308, a
@@ -9,11 +11,13 @@ An accepted mutant whose heightfield has at most RASTER_CELLS cells is also rast
 work every command does next). Each mutant runs under a wall-clock limit (SIGALRM); one that
 exceeds it counts as a hang.
 
-    python benchmarks/terrain_fuzz.py --mutants 2000 --seed 0 [--time-limit 20] [--out FILE]
+    python studies/terrain_fuzz.py --mutants 2000 --seed 0 [--time-limit 20] [--out FILE]
 
 Prints and writes (benchmarks/results/terrain_fuzz.json, or --out) the counts per outcome,
 the exceptions that were not TerrainError and the hangs (with their mutations), and the
 slowest mutant. Exit code 1 when any mutant raised something else or hung.
+
+Results: docs/results/2026-12-01-terrain-fuzz.
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
+sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks")]  # the package, benchmarks/common.py
 
 from leas_jax.terrain import TerrainError, loads_terrain  # noqa: E402
 
@@ -255,7 +259,7 @@ def fuzz(mutants: int, seed: int, time_limit: float) -> dict:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--mutants", type=int, default=2000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--time-limit", type=float, default=20.0, help="seconds per mutant (default 20)")

@@ -1,4 +1,5 @@
-"""Calibrate the reachability condition (docs/design.md §5) against the contact generator.
+"""Which cylinder parameters make the reachability condition (docs/design.md §5) agree best with
+the contact generator?
 
 Ground truth: a root pose (x, y, z, yaw) is *feasible* when the contact generator
 finds a balanced, collision-free double-support posture there
@@ -28,7 +29,7 @@ trunk cylinder is free iff the terrain under it stays below its bottom. The old 
 the chosen defaults are also evaluated with `reachability.valid` itself on
 `heightfield_from_terrain(terrain, EnvConfig(reachability=cfg))`, and must agree.
 
-Optional terms (benchmarks/reachability_false_positives.py): a second
+Optional terms (studies/reachability_false_positives.py): a second
 search (`TERMS_GRID`) adds the lookahead leg cylinders (`leg_forward`) and the foothold
 flatness term (`foothold_radius`, `foothold_search`, `foothold_spread`) of
 `leas_jax.env.reachability` to the thresholds above, on fewer radii (they cost a
@@ -54,7 +55,10 @@ poses, +-0.6 % on a sensitivity at 95 %; with the 12 000 used before commit 797a
 the chosen setting's 95.8 % fitting sensitivity was 94.9 % on fresh poses). On 2 cores:
 ~2.5 min of ground truth (walking; ~1.5 min static) and ~20 min of search.
 
-    python benchmarks/reachability_calibration.py [--poses 48000] [--workers 2] [--reuse]
+    python studies/reachability_calibration.py [--poses 48000] [--workers 2] [--reuse]
+
+Results: docs/results/2026-11-22-reachability-48000-poses; earlier calibrations in
+2026-11-21-benchmarks-generator-speed-ups and the 2026-11-22-benchmarks-* folders.
 """
 
 from __future__ import annotations
@@ -75,20 +79,26 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from leas_jax.feasibility.poses import (  # noqa: E402
+    ARENA,
+    NEAR_FRACTION,
+    REFERENCE_RADIUS,
+    Z_OFFSETS,
+    cylinder_verdicts,
+    sample_poses,
+)
 from leas_jax.feasibility.walking_truth import (  # noqa: E402
     WALK_POSES,
     WALK_SPEED,
     WALK_TIMESTEP,
     walking_guide,
 )
+from leas_jax.stats import confusion  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 REPO = Path(__file__).resolve().parent.parent
-ARENA = REPO / "terrains" / "training_arena.toml"
-Z_OFFSETS = (-0.55, 0.35)  # m, root height offsets about the nominal
-NEAR_FRACTION = 0.3  # share of poses drawn near obstacles
-REFERENCE_RADIUS = 0.15  # m, reference ground: highest point within this radius
 FLAT_HEIGHTS = (1.0, 1.01927)  # m: EnvConfig.nominal_root_height and contacts.NOMINAL_ROOT_HEIGHT
 FLAT_MARGIN = 0.02  # m, margin those must keep from every threshold
 TARGET_SENSITIVITY = 0.95
@@ -124,62 +134,6 @@ HANDS_GRID = {
     "hand": (None, 0.10, 0.13, 0.16, 0.20, 0.24),
     "hand_bottom": (-0.45, -0.40, -0.35, -0.30, -0.25),
 }
-
-
-# ------------------------------------------------------------------ poses
-
-
-def sample_poses(
-    terrain,
-    count: int,
-    seed: int = 0,
-    nominal: float = 1.0,
-    near_fraction: float = NEAR_FRACTION,
-    z_offsets=Z_OFFSETS,
-) -> np.ndarray:
-    """Seeded root poses on a terrain (see the module docstring).
-
-    Args:
-        terrain: a leas_jax.terrain.Terrain.
-        count: number of poses.
-        seed: numpy default_rng seed.
-        nominal: nominal root height above the reference ground, m.
-
-    Returns:
-        [count, 4] (x, y, z, yaw), world frame.
-    """
-    from leas_jax.env.field import disk_filter
-
-    rng = np.random.default_rng(seed)
-    heights = terrain.raster()
-    res = terrain.resolution
-    (x0, y0), (x1, y1) = terrain.bounds
-    margin = 0.3  # m, keep the legs' disks on the raster
-    n_near = int(round(near_fraction * count))
-    xy = np.column_stack(
-        [
-            rng.uniform(x0 + margin, x1 - margin, count - n_near),
-            rng.uniform(y0 + margin, y1 - margin, count - n_near),
-        ]
-    )
-    if n_near:
-        spread = disk_filter(heights, 0.35 / res, "max", terrain.void_height) - disk_filter(
-            heights, 0.35 / res, "min", terrain.void_height
-        )
-        # Not the raster border, where the void outside makes every point look "near".
-        border = int(np.ceil((margin + 0.35) / res))
-        spread[:border], spread[-border:], spread[:, :border], spread[:, -border:] = 0, 0, 0, 0
-        ij = np.argwhere(spread > 0.05)
-        pick = ij[rng.integers(0, len(ij), n_near)] if len(ij) else np.zeros((n_near, 2), int)
-        near = terrain.bounds[0] + pick * res + rng.uniform(-res / 2, res / 2, (n_near, 2))
-        near = np.clip(near, [x0 + margin, y0 + margin], [x1 - margin, y1 - margin])
-        xy = np.concatenate([xy, near])
-    reference = disk_filter(heights, REFERENCE_RADIUS / res, "max", terrain.void_height)
-    ij = np.clip(np.round((xy - terrain.bounds[0]) / res).astype(int), 0, np.array(heights.shape) - 1)
-    z = reference[ij[:, 0], ij[:, 1]] + nominal + rng.uniform(*z_offsets, len(xy))
-    yaw = rng.uniform(-np.pi, np.pi, len(xy))
-    poses = np.column_stack([xy, z, yaw])
-    return poses[rng.permutation(len(poses))]
 
 
 # ------------------------------------------------------------------ ground truth
@@ -242,7 +196,7 @@ def generator_fingerprint(truth: str) -> str:
 def cache_path(truth: str, seed: int, count: int) -> Path:
     """.cache/reachability_ground_truth_<truth>_seed<seed>_<count>.npz at the repository root
     (git-ignored): one file per pose set (`sample_poses(terrain, count, seed)`), so that
-    runs on other sets (benchmarks/reachability_validation.py) keep each other's."""
+    runs on other sets (studies/reachability_validation.py) keep each other's."""
     return REPO / ".cache" / f"reachability_ground_truth_{truth}_seed{seed}_{count}.npz"
 
 
@@ -274,18 +228,6 @@ def cached_ground_truth(
 
 
 # ------------------------------------------------------------------ condition
-
-
-def condition(terrain, poses: np.ndarray, config) -> np.ndarray:
-    """[N] `reachability.valid` (jitted, vmapped) at poses [N, 4] with `config` (a ReachabilityConfig)."""
-    import jax
-    import jax.numpy as jnp
-
-    from leas_jax.env import EnvConfig, heightfield_from_terrain, reachability
-
-    field = heightfield_from_terrain(terrain, EnvConfig(reachability=config))
-    valid = jax.jit(jax.vmap(lambda f, p: reachability.valid(f, p, config), in_axes=(None, 0)))
-    return np.asarray(valid(field, jnp.asarray(poses, dtype=jnp.float32)))
 
 
 def raster_samples(
@@ -396,29 +338,6 @@ def thresholds(
     if hand_bottom is not None:
         result = result & np.all(samples["hand"] < (z + f(hand_bottom))[:, None], axis=1)
     return result
-
-
-def confusion(predicted: np.ndarray, truth: np.ndarray) -> dict:
-    """Confusion counts and rates of a condition against the ground truth ([..., N] bool each).
-
-    Returns:
-        dict: tp, fn, fp, tn (condition true/false among feasible/infeasible poses),
-        sensitivity tp / (tp + fn) and specificity tn / (tn + fp) (NaN when undefined),
-        as Python numbers for a single condition, arrays for a batch.
-    """
-    predicted = np.asarray(predicted, dtype=bool)
-    truth = np.asarray(truth, dtype=bool)
-    tp = np.sum(predicted & truth, axis=-1)
-    fn = np.sum(~predicted & truth, axis=-1)
-    fp = np.sum(predicted & ~truth, axis=-1)
-    tn = np.sum(~predicted & ~truth, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sensitivity = np.where(tp + fn > 0, tp / np.maximum(tp + fn, 1), np.nan)
-        specificity = np.where(tn + fp > 0, tn / np.maximum(tn + fp, 1), np.nan)
-    out = {"tp": tp, "fn": fn, "fp": fp, "tn": tn, "sensitivity": sensitivity, "specificity": specificity}
-    if np.ndim(tp) == 0:
-        out = {k: (int(v) if k in ("tp", "fn", "fp", "tn") else float(v)) for k, v in out.items()}
-    return out
 
 
 def flat_ground_ok(trunk_bottom, leg_bottom, leg_top, heights=FLAT_HEIGHTS, margin: float = FLAT_MARGIN):
@@ -602,7 +521,7 @@ def grid_search(
 
 def figures(terrain, poses, truth, config, fit) -> dict:
     """Figures of one config with the jitted `reachability.valid`, on all / fit / held-out poses."""
-    predicted = condition(terrain, poses, config)
+    predicted = cylinder_verdicts(terrain, poses, config)
     return {
         "all": confusion(predicted, truth),
         "fit": confusion(predicted[fit], truth[fit]),
@@ -671,7 +590,7 @@ def main(argv=None) -> None:
     from leas_jax.terrain import load_terrain
     from leas_jax.training.config import REACHABILITY_TERMS_OFF, TRAINING_REACHABILITY
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--poses", type=int, default=48000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)

@@ -1,4 +1,5 @@
-"""The global layer: the lattice search against RBKino+RRT on the evaluation scenarios' starts.
+"""How often and how fast does the global layer's lattice search find a path from the evaluation
+scenarios' starts, against RBKino+RRT?
 
 For each scenario's seeded starts (the same draws as `leas evaluate`), in one process:
   - the lattice search (`leas_jax.navigate`): the valid set over 0.05 m cells x 16 headings,
@@ -9,18 +10,25 @@ Reports, per planner, how many starts get a path (with 95 % Wilson intervals) an
 median / p95 seconds per start, and their ratio. Geometric planners only: what the contact
 generator makes of the paths is `leas evaluate --methods ...,navigate`'s question.
 
-    python benchmarks/navigate_search.py [--scenarios bridge hole] [--n-starts 60] [--rrt-starts N]
+    python studies/navigate_search.py [--scenarios bridge hole] [--n-starts 60] [--rrt-starts N]
 
 Writes <out>/navigate_search.json.
+
+Results: docs/results/2026-12-01-navigate.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
-from common import add_out_argument, load_average, save, wilson
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # benchmarks/common.py
+
+from common import add_out_argument, load_average, save, wilson  # noqa: E402
 
 
 def summary(found: list[bool], seconds: list[float]) -> dict:
@@ -36,7 +44,7 @@ def summary(found: list[bool], seconds: list[float]) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenarios", nargs="+", default=["bridge", "hole"])
     parser.add_argument("--n-starts", type=int, default=60)
     parser.add_argument("--rrt-starts", type=int, default=None, help="RRT on the first N starts only")

@@ -22,13 +22,16 @@ generator covers fully, their mean coverage and the mean progress along the targ
 `--scenarios`, LeaS success on those scenarios (`leas evaluate`). Each figure comes with a
 95 % interval across seeds and starts (a two-level bootstrap: seeds, then starts within each).
 
-    python benchmarks/feasibility_study.py --out DIR [--seeds 0,1,2] [--geometric-steps N]
+    python studies/feasibility_study.py --out DIR [--seeds 0,1,2] [--geometric-steps N]
         [--planner-steps N] [--starts 256] [--eval-seeds 0,1] [--scenarios eval_stairs ...]
         [--clearance-condition condition|cylinders]
 
 Writes DIR/feasibility_study.json, feasibility_study.md and feasibility_study.png; training
 runs go to DIR/runs/<method>/seed<k>: a finished run is reused, and so is its evaluation
 (`study_evaluation.npz`, while the policy, the settings and the package's code are unchanged).
+
+Results: docs/results/2026-12-01-feasibility, 2026-12-02-ablation, 2026-12-02-retry-settings,
+2026-12-03-ablation, 2026-12-04-ablation-more-seeds, 2026-12-04-learned-clearance.
 """
 
 from __future__ import annotations
@@ -42,7 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 PACKAGE = Path(__file__).resolve().parent.parent / "leas_jax"
 METHODS = ("cylinders", "cylinders+planner", "learned", "learned+planner")
@@ -399,7 +403,7 @@ def main(argv=None) -> dict:
     from leas_jax.errors import UsageError
     from leas_jax.training.config import PLANNER_PRESETS, PRESETS
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", required=True)
     parser.add_argument("--methods", default=",".join(METHODS))
     parser.add_argument("--seeds", default="0,1,2")

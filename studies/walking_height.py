@@ -15,7 +15,9 @@ condition (EnvConfig defaults) says about the same poses:
 200 poses per guide (0.18 m/s, 0.1 s timestep), yaw 0. Writes
 <out>/walking_height.json.
 
-    python benchmarks/walking_height.py [--heights 0.8,0.85,...] [--radius 0.15]
+    python studies/walking_height.py [--heights 0.8,0.85,...] [--radius 0.15]
+
+Results: docs/results/2026-11-22-benchmarks-crouched-walking, 2026-11-22-benchmarks-sole-margins.
 """
 
 from __future__ import annotations
@@ -26,7 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 from common import add_out_argument, load_average, save  # noqa: E402
 
@@ -63,7 +66,7 @@ def straight_guide(terrain, x0: float, y0: float, height: float, radius: float) 
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--heights",
         default="0.80,0.85,0.90,0.95,1.00,1.05,1.10,1.15",

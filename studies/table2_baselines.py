@@ -1,4 +1,5 @@
-"""Table II's baselines (RBLin, RBKino) on eval_ground as the paper ran them, against its figures.
+"""Do Table II's baselines (RBLin, RBKino) on eval_ground, run as the paper ran them, reach its
+figures?
 
 Paper §IV-B.1 / Table II: flat ground, a target 4 m away, the start yaw turned
 -30..30, 60..120 or 150..210 degrees from the target direction, an initial speed
@@ -33,7 +34,7 @@ and two diagnostics of the generator's turning:
                    planning pose, `GeneratorConfig.planning_interval`) and the largest
                    one within any 0.5 s, next to its coverage.
 
-    nice -n 10 python benchmarks/table2_baselines.py --out docs/results/2026-12-01-table2-baselines \\
+    nice -n 10 python studies/table2_baselines.py --out docs/results/2026-12-01-table2-baselines \\
         [--n-starts 60] [--workers 2] [--variants rblin,rbkino,rbkino_cruise] \\
         [--sweep-steps 5,10,20,50] [--sweep-speeds 0.04] [--generator-strides 1] [--set NAME=VALUE ...]
 
@@ -43,6 +44,10 @@ e.g. `--set refine_stride=10` to refine a 0.01 s guide every 0.1 s only.
 Writes <out>/table2_baselines.json (per cell and variant: n, mean coverage with a 95 %
 bootstrap interval, fully covered and success fractions with 95 % Wilson intervals, the
 paper's figure; every trajectory) and <out>/table2_baselines.png.
+
+Results: docs/results/2026-12-01-table2-baselines, 2026-12-03-table2-hpp-sampling,
+2026-12-03-rbkino-hpp-sampling, and the table2 folders of 2026-12-02-refined-planning-poses,
+2026-12-02-retry-settings, 2026-12-02-stance-arm-shifts, 2026-12-02-step-fallback.
 """
 
 from __future__ import annotations
@@ -56,7 +61,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 from common import (  # noqa: E402
     add_generator_settings_argument,
@@ -299,7 +305,7 @@ def sweep_panel(ax, report: dict) -> None:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--n-starts", type=int, default=60, help="starts per cell (paper: 60)")
     parser.add_argument("--workers", type=int, default=2, help="contact-generator processes")
@@ -383,7 +389,7 @@ def main(argv=None) -> None:
         return [t for t in trajectories if t.method == label and t.cell == k]
 
     report = {
-        "command": "python benchmarks/table2_baselines.py "
+        "command": "python studies/table2_baselines.py "
         + " ".join(argv if argv is not None else sys.argv[1:]),
         "baseline_config": dataclasses.asdict(base),
         "generator_settings": {name: repr(value) for name, value in settings.items()},

@@ -1,6 +1,7 @@
-"""False positives of the reachability condition against the contact generator.
+"""Which poses does the reachability condition accept where the contact generator cannot stand or
+walk, and what do they have in common?
 
-The poses, ground truth and condition are those of benchmarks/reachability_calibration.py
+The poses, ground truth and condition are those of studies/reachability_calibration.py
 (same seed, same cache in .cache/, `--truth walking` by default: feasible = the generator
 covers a 0.36 m straight guide from the pose). A false positive (FP) is a pose where
 `reachability.valid` holds with the given configuration (default: the current
@@ -23,7 +24,10 @@ The FPs are then put in exclusive classes (first match, in the order of `CLASSES
 printed with the TPs that fall in the same class: a term removing a class costs those TPs.
 Writes <out>/reachability_false_positives[_<truth>].json.
 
-    python benchmarks/reachability_false_positives.py [--truth walking] [--reuse] [--no-generator]
+    python studies/reachability_false_positives.py [--truth walking] [--reuse] [--no-generator]
+
+Results: --out (default benchmarks/results/); its classes led to the optional terms of
+`leas_jax.env.reachability` (docs/results/2026-11-22-reachability-48000-poses).
 """
 
 from __future__ import annotations
@@ -42,11 +46,14 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 import reachability_calibration as rc  # noqa: E402
 
+from leas_jax.feasibility.poses import ARENA, REFERENCE_RADIUS, cylinder_verdicts, sample_poses  # noqa: E402
 from leas_jax.feasibility.walking_truth import WALK_SPEED, WALK_TIMESTEP, walking_guide  # noqa: E402
+from leas_jax.stats import confusion  # noqa: E402
 
 SOLE_RADIUS = 0.08  # m, disk of the leg spread (sole 0.20 x 0.13 m: inscribed 0.065, circumscribed 0.12)
 EDGE_JUMP = 0.03  # m, a height jump between neighbouring cells that makes an edge
@@ -101,7 +108,7 @@ def features(terrain, poses: np.ndarray, config) -> dict:
         [poses[:, :2] + config.leg_lateral_offset * side, poses[:, :2] - config.leg_lateral_offset * side],
         axis=1,
     )  # [N, 2 legs, 2]
-    reference = disk_filter(heights, rc.REFERENCE_RADIUS / res, "max", void)
+    reference = disk_filter(heights, REFERENCE_RADIUS / res, "max", void)
     leg_highest = disk_filter(_solid(heights, void, -np.inf), config.leg_radius / res, "max", -np.inf)
     sole_highest = disk_filter(_solid(heights, void, np.inf), SOLE_RADIUS / res, "max", np.inf)
     sole_lowest = disk_filter(heights, SOLE_RADIUS / res, "min", void)
@@ -124,7 +131,7 @@ def features(terrain, poses: np.ndarray, config) -> dict:
 def valid_ahead(terrain, poses: np.ndarray, config) -> np.ndarray:
     """[N] whether the condition holds at every pose of each pose's walking guide (`walking_truth.walking_guide`)."""
     guides = np.stack([walking_guide(p) for p in poses])  # [N, WALK_POSES, 4]
-    return rc.condition(terrain, guides.reshape(-1, 4), config).reshape(len(poses), -1).all(axis=1)
+    return cylinder_verdicts(terrain, guides.reshape(-1, 4), config).reshape(len(poses), -1).all(axis=1)
 
 
 def _outcome_chunk(poses: np.ndarray) -> np.ndarray:
@@ -191,11 +198,11 @@ def main(argv=None) -> None:
     from leas_jax.env import ReachabilityConfig
     from leas_jax.terrain import load_terrain
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--poses", type=int, default=48000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--terrain", default=str(rc.ARENA))
+    parser.add_argument("--terrain", default=str(ARENA))
     parser.add_argument("--truth", choices=("static", "walking"), default="walking")
     parser.add_argument("--reuse", action="store_true", help="reuse the cached ground truth if it matches")
     parser.add_argument("--no-generator", action="store_true", help="skip the generator outcome of each FP")
@@ -205,11 +212,11 @@ def main(argv=None) -> None:
 
     terrain = load_terrain(args.terrain)
     config = ReachabilityConfig()
-    poses = rc.sample_poses(terrain, args.poses, args.seed)
+    poses = sample_poses(terrain, args.poses, args.seed)
     truth, _ = rc.cached_ground_truth(terrain, poses, args.truth, args.workers, args.reuse, args.seed)
-    predicted = rc.condition(terrain, poses, config)
+    predicted = cylinder_verdicts(terrain, poses, config)
     fp, tp = predicted & ~truth, predicted & truth
-    figures = rc.confusion(predicted, truth)
+    figures = confusion(predicted, truth)
     f = features(terrain, poses, config)
     ahead = valid_ahead(terrain, poses, config)
     cls = classify(f, ahead)
@@ -254,7 +261,7 @@ def main(argv=None) -> None:
     kind_rows = []
     for kind in kinds:
         sel = f["kind"] == kind
-        c = rc.confusion(predicted[sel], truth[sel])
+        c = confusion(predicted[sel], truth[sel])
         kind_rows.append({"kind": kind, **c})
         print(f"{kind:14s} {c['fp']:5d} {c['tp']:5d} {c['tn']:5d} {c['fn']:5d} {100 * c['specificity']:6.1f}")
 

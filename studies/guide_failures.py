@@ -1,4 +1,4 @@
-"""Where and why the contact generator stops on a policy's own arena guides.
+"""Where and why does the contact generator stop on a policy's own arena guides?
 
 For a trained policy (deterministic), run `--starts` episodes from the env's own random
 resets on its training arena (`leas_jax.eval.geometric.arena_episodes`, 400 steps), plan
@@ -27,8 +27,14 @@ guides, deterministic episodes), e.g. before and after a
 generator change, and writes <out>/paired.json: the guides one covers fully and the other
 does not ("fixed", "broken") and a two-sided sign test on those counts.
 
-    python benchmarks/guide_failures.py --policy checkpoints/leas_talos --starts 64 --workers 2 --what-if
-    python benchmarks/guide_failures.py --compare OLD/guide_failures.json NEW/guide_failures.json --out NEW
+    python studies/guide_failures.py --policy checkpoints/leas_talos --starts 64 --workers 2 --what-if
+    python studies/guide_failures.py --compare OLD/guide_failures.json NEW/guide_failures.json --out NEW
+
+Results (the guides folders of): docs/results/2026-12-01-learned-paper, 2026-12-01-path-condition,
+2026-12-01-verified-spawns, 2026-12-02-arms-in, 2026-12-02-column-sampling, 2026-12-02-planner-phase,
+2026-12-02-refined-planning-poses, 2026-12-02-retry-settings, 2026-12-02-stance-arm-shifts,
+2026-12-02-step-fallback, 2026-12-03-planner-phase-settings, 2026-12-04-ship-learned,
+2026-12-05-higher-swing-retries, 2026-12-05-relabelled-condition, 2026-12-05-swing-lift-on-rise.
 """
 
 from __future__ import annotations
@@ -43,7 +49,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 CELL_COMMENT = re.compile(
     r"#\s*cell \((\d+), (\d+)\) \[([-\d.]+), ([-\d.]+)\] x \[([-\d.]+), ([-\d.]+)\]:\s*(\S+)"
@@ -196,7 +203,7 @@ def main(argv=None) -> dict:
 
     from leas_jax.contacts.planner.config import GeneratorConfig
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--policy", default="checkpoints/leas_talos", help="run directory or policy.ckpt")
     parser.add_argument("--starts", type=int, default=64)
     parser.add_argument("--seed", type=int, default=0, help="evaluation seed of the resets")

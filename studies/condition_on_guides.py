@@ -10,8 +10,10 @@ path. Writes condition_on_guides.json and .md into --out.
 
     leas evaluate --scenario bridge,stairs,stairs_side --methods leas \
         --checkpoint checkpoints/leas_talos/pretrain --out /tmp/cylinders_eval
-    python benchmarks/condition_on_guides.py --evaluation /tmp/cylinders_eval \
+    python studies/condition_on_guides.py --evaluation /tmp/cylinders_eval \
         --policy docs/results/2026-12-01-learned-paper/train_paper_learned --out DIR
+
+Results: docs/results/2026-12-01-learned-paper, docs/results/2026-12-01-path-condition.
 """
 
 from __future__ import annotations
@@ -23,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+HERE = Path(__file__).resolve().parent
+sys.path[:0] = [str(HERE), str(HERE.parent / "benchmarks")]  # the other studies, benchmarks/common.py
 
 
 def rejection_fn(field, env_config):
@@ -39,7 +42,7 @@ def rejection_fn(field, env_config):
 def main(argv=None) -> dict:
     from common import add_out_argument, load_average, save, wilson
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--evaluation", type=Path, required=True, help="a `leas evaluate` --out folder")
     parser.add_argument(
         "--policy", required=True, help="run directory or policy.ckpt whose condition is applied"

@@ -227,7 +227,7 @@ def main(argv=None) -> dict:
 
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.env.learned_weights import load_params, save_params
-    from leas_jax.feasibility import FitConfig, features_of, fit, predict
+    from leas_jax.feasibility.fit import FitConfig, features_of, fit, predict
     from leas_jax.feasibility.spawns import arena_field
     from leas_jax.files import resolve_data_path
     from leas_jax.stats import rates

@@ -145,7 +145,7 @@ def test_anchor_samples_carry_the_conditions_own_verdicts():
 
 def test_seed_data_is_fitted_at_every_refresh(tmp_path, monkeypatch):
     """`TrainConfig.condition_seed_data`: its labelled poses join the verdicts in every refit."""
-    import leas_jax.feasibility as feasibility
+    import leas_jax.feasibility.fit as feasibility
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.terrain import load_terrain
     from leas_jax.training.planner import VerdictData
@@ -230,10 +230,10 @@ def test_a_refit_sets_its_threshold_for_the_configured_sensitivity(tmp_path, mon
     """`TrainConfig.condition_refresh_sensitivity` is the target sensitivity a refit sets its
     threshold for (None: FitConfig's); a higher one gives a threshold no higher, from the same
     data and weights."""
-    import leas_jax.feasibility as feasibility
+    import leas_jax.feasibility.fit as feasibility
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.errors import UsageError
-    from leas_jax.feasibility import FitConfig
+    from leas_jax.feasibility.fit import FitConfig
     from leas_jax.terrain import load_terrain
     from leas_jax.training.planner import VerdictData
 

@@ -13,8 +13,15 @@ import pytest
 
 from leas_jax.env import EnvConfig, LeasEnv, condition, heightfield_from_terrain, reachability
 from leas_jax.env import learned_feasibility as lf
-from leas_jax.feasibility import FitConfig, features_of, fit, predict
-from leas_jax.feasibility.fit import balanced_weights, mirrored, threshold_for
+from leas_jax.feasibility.fit import (
+    FitConfig,
+    balanced_weights,
+    features_of,
+    fit,
+    mirrored,
+    predict,
+    threshold_for,
+)
 from leas_jax.feasibility.walking_truth import WALK_TIMESTEP, walking_guide
 from leas_jax.terrain import load_terrain
 from leas_jax.training.config import TRAINING_ENV

@@ -408,7 +408,7 @@ class VerdictData:
 
     def refresh(self, field: Heightfield) -> tuple[Heightfield, dict]:
         """The field with the condition refitted on every verdict so far, and the fit's info."""
-        from leas_jax.feasibility import FitConfig, features_of, fit
+        from leas_jax.feasibility.fit import FitConfig, features_of, fit
 
         reach = self.config.env.reachability
         if self.refreshes == 0 and self.config.condition_anchor_poses > 0:

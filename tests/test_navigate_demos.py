@@ -3,7 +3,7 @@ studies/navigate_demos.py, which navigates their queries and verifies each plan.
 
 The demo files must hold the queries of hpp-rbprm-corba's Talos scripts (HPP_QUERIES,
 copied from talos_*_path.py of its v4.12.0), the rough scenes 20 starts and a target on
-either side of their difficult part. The quick tier runs the benchmark on the flat-ground
+either side of their difficult part. The quick tier runs the study on the flat-ground
 demo (as a demo and as a one-start scene); the slow tier runs every demo query and wants
 it reached with a plan that verifies.
 """
@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "studies"), str(ROOT / "benchmarks")]
 
 import common  # noqa: E402
-import navigate_demos as bench  # noqa: E402
+import navigate_demos as study  # noqa: E402
 
 DEMOS = sorted((ROOT / "terrains" / "hpp" / "demos").glob("*.toml"))
 ROUGH = sorted((ROOT / "terrains" / "hpp" / "rough").glob("*.toml"))
@@ -50,7 +50,7 @@ def test_every_demo_file_holds_its_hpp_script_query():
         mesh, (x, y, yaw_deg), goal = HPP_QUERIES[path.stem]
         terrain = load_terrain(path)
         assert terrain.meshes[0].source == f"hpp-environments:multicontact/{mesh}"
-        start, target = bench.demo_query(terrain.scenario)
+        start, target = study.demo_query(terrain.scenario)
         np.testing.assert_allclose(start[:2], (x, y), err_msg=path.stem)
         # the yaw offset in the file is rounded to 1e-6 deg
         assert math.remainder(start[2] - math.radians(yaw_deg), 2 * math.pi) == pytest.approx(0.0, abs=1e-7)
@@ -61,7 +61,7 @@ def test_every_demo_file_holds_its_hpp_script_query():
 def test_demo_query_refuses_a_scenario_that_draws_starts():
     scenario = load_terrain(ROUGH[0]).scenario
     with pytest.raises(ValueError, match="one query"):
-        bench.demo_query(scenario)
+        study.demo_query(scenario)
 
 
 @pytest.mark.parametrize("path", ROUGH, ids=lambda p: p.stem)
@@ -80,37 +80,37 @@ def test_rough_scene_crosses_its_difficult_part(path):
 
 
 def _row(reached, verify_ok, reason="reached"):
-    row = bench.refused_row(reason, "m")
+    row = study.refused_row(reason, "m")
     row.update(reached=reached, verify_ok=verify_ok)
     return row
 
 
 def test_scene_summary_counts_only_reached_plans_that_verify():
     rows = [_row(True, True), _row(True, False), _row(False, None, "no-path"), _row(False, None, "refused")]
-    summary = bench.scene_summary(rows)
+    summary = study.scene_summary(rows)
     assert (summary["successes"], summary["trials"]) == (1, 4)
     assert summary["wilson_95"] == list(common.wilson(1, 4))
     assert summary["reasons"] == {"reached": 2, "no-path": 1, "refused": 1}
-    table = bench.demo_table([{"demo": "d", **rows[1]}, {"demo": "e", **rows[3]}])
+    table = study.demo_table([{"demo": "d", **rows[1]}, {"demo": "e", **rows[3]}])
     assert "| d | yes | reached |" in table and "| NO |" in table
     assert table.splitlines()[-1].endswith("| 0 | 0 | - |")
 
 
 def test_other_seconds_is_the_total_less_the_parts():
     seconds = {"lattice": 1.0, "search": 0.5, "rollout": 2.0, "contact_planning": 0.25, "total": 5.0}
-    assert bench.other_seconds(seconds) == pytest.approx(1.25)
-    assert bench.other_seconds({**seconds, "total": None}) is None
+    assert study.other_seconds(seconds) == pytest.approx(1.25)
+    assert study.other_seconds({**seconds, "total": None}) is None
 
 
 def test_a_glob_that_matches_nothing_ends_the_run():
     with pytest.raises(SystemExit, match="matches no file"):
-        bench.expand(["terrains/hpp/demos/no_such_*.toml"])
+        study.expand(["terrains/hpp/demos/no_such_*.toml"])
 
 
-def test_benchmark_runs_the_flat_ground_demo_and_scene(tmp_path, capsys):
+def test_study_runs_the_flat_ground_demo_and_scene(tmp_path, capsys):
     """The flat-ground demo, once as a demo query (cold) and once as a scene of one start:
     both reach the goal with a plan that verifies; the JSON records machine, load and commit."""
-    bench.main(["--demos", str(FLAT), "--terrains", str(FLAT), "--out", str(tmp_path)])
+    study.main(["--demos", str(FLAT), "--terrains", str(FLAT), "--out", str(tmp_path)])
     saved = json.loads((tmp_path / "navigate_demos.json").read_text())
     assert {"machine", "git", "load_average_before", "load_average_after"} <= set(saved)
     (demo,) = saved["demos"]
@@ -143,6 +143,6 @@ SLOW_DEMOS = [
 def test_demo_query_is_reached_and_its_plan_verifies(path):
     from leas_jax.training import load_policy
 
-    row = bench.run_demo(load_policy(ROOT / "checkpoints" / "leas_talos"), path, workers=0)
+    row = study.run_demo(load_policy(ROOT / "checkpoints" / "leas_talos"), path, workers=0)
     assert row["reached"], row["message"]
     assert row["verify_ok"], row["verify_failures"]

@@ -146,7 +146,7 @@ def test_a_target_inside_an_obstacle_is_refused_by_the_start_draw():
 
 
 def test_seeded_fuzz_of_the_committed_terrains_raises_only_terrain_errors():
-    """300 mutants (the committed benchmark runs 3000): no other exception, no hang."""
+    """300 mutants (the committed study runs 3000): no other exception, no hang."""
     report = terrain_fuzz.fuzz(300, seed=10_000, time_limit=20.0)
     assert report["non_terrain_errors"] == 0 and report["hangs"] == 0, report["failures"][:3]
     assert report["counts"]["TerrainError"] > 200 and report["counts"].get("accepted", 0) > 10

@@ -335,9 +335,15 @@ def test_feasibility_condition_command_runs_end_to_end(tmp_path, capsys, monkeyp
             "--compare-weights .*missing.npz: no such file",
         ),
         (["--test-seed", "13"], "seeds must differ"),
+        (["--weights", str(tmp_path / "w.txt")], "--weights: expected a .npz file"),
+        (["--train-poses", "0"], "--train-poses"),
     ):
-        assert main([*tiny, *bad]) == 2
+        try:
+            code = main([*tiny, *bad])
+        except SystemExit as exit_:  # argparse's own errors
+            code = exit_.code
         err = capsys.readouterr().err.strip()
+        assert code == 2, bad
         assert len(err.splitlines()) == 1 and re.search(message, err), err
 
 

@@ -29,30 +29,41 @@ def _scenes(patterns: list[str]):
     return [load_terrain(f) for f in files]
 
 
-def cmd_condition(args) -> int:
-    """Label, fit, write the weights and the report of the learned condition."""
-    from leas_jax.feasibility.condition_build import ConditionBuild, build
+def _condition_options(args):
+    """The `ConditionBuild` of the `condition` target's arguments (an option per field;
+    --no-mirror for `mirror`).
+
+    Raises:
+        UsageError: a --compare-weights file is missing, --weights is no .npz, or a validation
+            seed is its training seed (the validation poses must be fresh).
+    """
+    import dataclasses
+
+    from leas_jax.feasibility.condition_build import ConditionBuild
     from leas_jax.files import resolve_data_path
 
     for other in args.compare_weights:
         if not resolve_data_path(other).is_file():
             raise UsageError(f"--compare-weights {other}: no such file")
+    if Path(args.weights).suffix != ".npz":
+        raise UsageError(f"--weights: expected a .npz file, got {args.weights}")
     if args.train_seed == args.test_seed or args.policy_train_seed == args.policy_seed:
         raise UsageError("the training and validation seeds must differ (the validation poses must be fresh)")
-    options = ConditionBuild(
-        **{
-            f: getattr(args, f)
-            for f in ("train_poses", "train_seed", "policy_train_poses", "policy_train_seed")
-        },
-        **{f: getattr(args, f) for f in ("test_poses", "test_seed", "policy_poses", "policy_seed", "policy")},
-        **{
-            f: getattr(args, f)
-            for f in ("workers", "steps", "weights", "cost_envs", "cost_steps", "cost_repeats")
-        },
-        mirror=not args.no_mirror,
-        compare_weights=tuple(args.compare_weights),
-        cache=args.cache,
-    )
+    given = {
+        f.name: getattr(args, f.name)
+        for f in dataclasses.fields(ConditionBuild)
+        if f.name not in ("mirror", "compare_weights")
+    }
+    return ConditionBuild(**given, mirror=not args.no_mirror, compare_weights=tuple(args.compare_weights))
+
+
+def cmd_condition(args) -> int:
+    """Label, fit, write the weights and the report of the learned condition (into --out, by
+    default the weights' folder)."""
+    from leas_jax.feasibility.condition_build import build
+    from leas_jax.files import resolve_data_path
+
+    options = _condition_options(args)
     out = Path(args.out) if args.out else resolve_data_path(args.weights).parent
     build(options, out)
     print(f"wrote {out / 'feasibility_condition.json'} and {out / 'feasibility_condition.md'}")

@@ -205,32 +205,12 @@ def validation_rows(terrain, field, params, compared: dict, poses: np.ndarray, x
     return rows
 
 
-def build(options: ConditionBuild, out: Path, say=print) -> dict:
-    """Data, fit and report of the learned condition on the training arena (host).
-
-    Labels the four pose sets (module docstring), fits the network on the training ones, writes
-    the weights to `options.weights` (a path as given or relative to the repository), validates
-    on the other two and returns the report, also written to `out` as feasibility_condition.json
-    (with the machine, load and commit) and feasibility_condition.md.
-    """
-    import jax
-
-    from leas_jax.contacts.planner.generator import GeneratorConfig
-    from leas_jax.env import EnvConfig, ReachabilityConfig, heightfield_from_terrain
-    from leas_jax.env import learned_feasibility as lf
-    from leas_jax.feasibility.fit import FitConfig, features_of, fit, predict
-    from leas_jax.feasibility.poses import ARENA
-    from leas_jax.feasibility.walking_truth import dataset_key
-    from leas_jax.files import atomic_write_text, resolve_data_path
-    from leas_jax.provenance import git_state, load_average, provenance
-    from leas_jax.stats import rates
-    from leas_jax.terrain import load_terrain
+def labelled_sets(options: ConditionBuild, terrain, say=print) -> dict:
+    """{set: (poses [N, 4], labels [N] bool)} of the four pose sets of a build: train,
+    policy_train (the fit), fresh and policy (the validation); a set of 0 poses is empty."""
     from leas_jax.training.policy import load_policy
 
     o = options
-    load_before, git = load_average(), git_state()
-    began = time.perf_counter()
-    terrain = load_terrain(ARENA)
     policy = load_policy(o.policy) if o.policy_poses or o.policy_train_poses else None
     plan = {
         "train": ("fresh", o.train_poses, o.train_seed),
@@ -242,6 +222,67 @@ def build(options: ConditionBuild, out: Path, say=print) -> dict:
     for name, (kind, count, seed) in plan.items():
         say(f"labelling {name}: {count} {kind} poses (seed {seed})")
         sets[name] = labelled_set(terrain, kind, count, seed, o.workers, Path(o.cache), policy)
+    return sets
+
+
+def save_weights(path: Path, params, key: str, options: ConditionBuild, config) -> None:
+    """Write the fitted weights with their data key, terrain and settings (`stale_weights` reads
+    the key and the terrain)."""
+    from leas_jax.env import ReachabilityConfig
+    from leas_jax.env import learned_feasibility as lf
+    from leas_jax.feasibility.poses import ARENA
+
+    o = options
+    lf.save_params(
+        path,
+        params,
+        data_key=key,
+        terrain=f"terrains/{ARENA.name}",
+        train=f"{o.train_poses} fresh (seed {o.train_seed}) + {o.policy_train_poses} policy "
+        f"(seed {o.policy_train_seed}) poses",
+        fit=json.dumps(dataclasses.asdict(config)),
+        reachability=json.dumps(dataclasses.asdict(ReachabilityConfig())),  # whose margins it reads
+    )
+
+
+def data_description(options: ConditionBuild, sets: dict) -> dict:
+    """The report's description of the pose sets, with each one's feasible fraction."""
+    o = options
+    return {
+        "train": f"{o.train_poses} fresh poses (seed {o.train_seed}) + {o.policy_train_poses} "
+        f"poses of {o.policy}'s arena guides (seed {o.policy_train_seed})",
+        "fresh": f"{o.test_poses} fresh poses (seed {o.test_seed})",
+        "policy": f"{o.policy_poses} poses of {o.policy}'s arena guides (seed {o.policy_seed})",
+        "feasible_fraction": {n: float(y.mean()) if len(y) else None for n, (_, y) in sets.items()},
+    }
+
+
+def build(options: ConditionBuild, out: Path, say=print) -> dict:
+    """Data, fit and report of the learned condition on the training arena (host).
+
+    Labels the four pose sets (`labelled_sets`), fits the network on the training ones, writes
+    the weights to `options.weights` (a path as given or relative to the repository), validates
+    on the other two and returns the report, also written to `out` as feasibility_condition.json
+    (with the machine, load and commit) and feasibility_condition.md.
+    """
+    import jax
+
+    from leas_jax.contacts.planner.generator import GeneratorConfig
+    from leas_jax.env import EnvConfig, heightfield_from_terrain
+    from leas_jax.env import learned_feasibility as lf
+    from leas_jax.feasibility.fit import FitConfig, features_of, fit, predict
+    from leas_jax.feasibility.poses import ARENA
+    from leas_jax.feasibility.walking_truth import dataset_key
+    from leas_jax.files import atomic_write_text, resolve_data_path
+    from leas_jax.provenance import git_state, load_average, provenance
+    from leas_jax.stats import rates
+    from leas_jax.terrain import load_terrain
+
+    o = options
+    load_before, git = load_average(), git_state()
+    began = time.perf_counter()
+    terrain = load_terrain(ARENA)
+    sets = labelled_sets(o, terrain, say)
     config = FitConfig(mirror=o.mirror)
     if o.steps is not None:
         config = dataclasses.replace(config, steps=o.steps)
@@ -255,19 +296,7 @@ def build(options: ConditionBuild, out: Path, say=print) -> dict:
     info["fit_seconds"] = round(time.perf_counter() - t0, 1)
     key = dataset_key(terrain.text, GeneratorConfig())
     weights = resolve_data_path(o.weights)
-    train_text = (
-        f"{o.train_poses} fresh (seed {o.train_seed}) + {o.policy_train_poses} policy "
-        f"(seed {o.policy_train_seed}) poses"
-    )
-    lf.save_params(
-        weights,
-        params,
-        data_key=key,
-        terrain=f"terrains/{ARENA.name}",
-        train=train_text,
-        fit=json.dumps(dataclasses.asdict(config)),
-        reachability=json.dumps(dataclasses.asdict(ReachabilityConfig())),  # whose margins it reads
-    )
+    save_weights(weights, params, key, o, config)
     say(f"wrote {weights} (fit {info['fit_seconds']} s, threshold {info['threshold']:.3f})")
 
     compared = {name: lf.load_params(resolve_data_path(name))[0] for name in o.compare_weights}
@@ -285,13 +314,7 @@ def build(options: ConditionBuild, out: Path, say=print) -> dict:
         "terrain": f"terrains/{ARENA.name}",
         "policy": o.policy,
         "data_key": key,
-        "data": {
-            "train": f"{o.train_poses} fresh poses (seed {o.train_seed}) + {o.policy_train_poses} "
-            f"poses of {o.policy}'s arena guides (seed {o.policy_train_seed})",
-            "fresh": f"{o.test_poses} fresh poses (seed {o.test_seed})",
-            "policy": f"{o.policy_poses} poses of {o.policy}'s arena guides (seed {o.policy_seed})",
-            "feasible_fraction": {n: float(y.mean()) if len(y) else None for n, (_, y) in sets.items()},
-        },
+        "data": data_description(o, sets),
         "fit": dataclasses.asdict(config),
         "fit_info": info,
         "weights": str(o.weights),

@@ -16,7 +16,7 @@ Everything here is host code around jitted pieces (`judge` is jitted and vmapped
     and the model's verdicts, shared with the lattice;
   - `family_poses`, `walking_labels`: data (labels cached on disk under a key of the terrain
     text, the generator's settings and code; resumable);
-  - `build`: data, fit and report in one call (`leas walkability`).
+  - `build`: data, fit and report in one call (`leas feasibility walkability`).
 """
 
 from __future__ import annotations
@@ -158,7 +158,7 @@ def judge_poses(
 
 
 def load_walkability(path, reach):
-    """The walkability model's `LearnedParams` from an .npz of `leas walkability` (a path as given
+    """The walkability model's `LearnedParams` from an .npz of `leas feasibility walkability` (a path as given
     or relative to the repository).
 
     Raises:

@@ -176,7 +176,7 @@ def register(subparsers) -> None:
         "--walkability",
         metavar="WEIGHTS.npz",
         default=None,
-        help="the walkability model (`leas walkability`) judges which plausible ground is confident "
+        help="the walkability model (`leas feasibility walkability`) judges which plausible ground is confident "
         "(default: the policy's reachability condition)",
     )
     parser.add_argument(

@@ -80,7 +80,7 @@ class LatticeConfig:
     # over the strip. The edge of a platform stays an edge (a morphological closing of the
     # solid ground, which fills strips bounded on both sides only).
     crack_width: float = 0.10
-    # The walkability model's weights (`leas walkability`), or None: the confident verdict is
+    # The walkability model's weights (`leas feasibility walkability`), or None: the confident verdict is
     # then the env's reachability condition. With a model, a plausible pose is confident where
     # the model accepts it.
     walkability: str | None = None

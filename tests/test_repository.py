@@ -11,6 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 THIS_FILE = Path(__file__).resolve().relative_to(ROOT).as_posix()
 
 DOCS_FILE_LIMIT = 2_000_000  # bytes
+DOCS_TOTAL_LIMIT = 25_000_000  # bytes, all tracked files under docs/ together
 
 # "issue 19", "Issue 22", "issues #3", "ticket 7", "PR #12", "pull request 4"
 TRACKER_REFERENCE = re.compile(r"\b(issues?|tickets?|PR|pull requests?)(\s+#?|\s*#)\d+\b", re.IGNORECASE)
@@ -53,3 +54,10 @@ def test_no_tracked_file_under_docs_is_over_the_limit():
     sizes = {path: (ROOT / path).stat().st_size for path in tracked_files() if path.startswith("docs/")}
     assert sizes, "no tracked file under docs/"
     assert {path: size for path, size in sizes.items() if size > DOCS_FILE_LIMIT} == {}
+
+
+def test_the_tracked_files_under_docs_stay_under_the_total():
+    """Figures are palette PNGs and bulky JSON is written without indentation, which keeps docs/ light."""
+    sizes = [(ROOT / path).stat().st_size for path in tracked_files() if path.startswith("docs/")]
+    assert sizes, "no tracked file under docs/"
+    assert sum(sizes) <= DOCS_TOTAL_LIMIT, f"docs/ holds {sum(sizes)} bytes, over {DOCS_TOTAL_LIMIT}"

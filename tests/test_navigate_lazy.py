@@ -274,3 +274,24 @@ def test_a_walkability_model_of_other_cylinders_is_refused_naming_the_file(polic
         _lattice(policy, loads_terrain(ROUGH_STRIP), walkability=other)
     with pytest.raises(UsageError, match="missing.npz"):
         _lattice(policy, loads_terrain(ROUGH_STRIP), walkability=str(tmp_path / "missing.npz"))
+
+
+def test_evaluate_hands_the_walkability_model_to_navigate(tmp_path):
+    import subprocess
+    import sys
+
+    terrain = tmp_path / "strip.toml"
+    scenario = (
+        "\n[scenario]\ntarget = [6.0, 1.5]\nstart_region = [[0.8, 1.3], [1.2, 1.7]]\nstart_yaw_deg = [-10.0, 10.0]\n"
+        "start_speed = [0.0, 0.0]\nn_starts = 1\nseed = 0\n"
+    )
+    terrain.write_text(ROUGH_STRIP + scenario)
+    run = subprocess.run(
+        [sys.executable, "-m", "leas_jax.cli", "evaluate", "--terrain", str(terrain), "--methods", "navigate"]
+        + ["--checkpoint", str(SHIPPED), "--workers", "0", "--no-progress", "--out", str(tmp_path / "eval")]
+        + ["--navigate-walkability", str(tmp_path / "missing.npz")],
+        capture_output=True,
+        text=True,
+    )
+    lines = [line for line in run.stderr.splitlines() if line.strip() and "warp" not in line]
+    assert run.returncode == 2 and len(lines) == 1 and "missing.npz" in lines[0], run.stderr

@@ -91,6 +91,7 @@ def cmd_evaluate(args) -> int:
         leas_stop_at_invalid=args.leas_stop_at_invalid,
         rbkino_timestep=args.rbkino_timestep,
         motion_plans=motion_plans,
+        navigate_config=_navigate_config(args),
     )
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))
@@ -184,6 +185,20 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
     parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
 
 
+def _navigate_config(args):
+    """The navigate method's `NavigateConfig`: its defaults, with the walkability model given."""
+    if args.navigate_walkability is None:
+        return None
+    import dataclasses
+
+    from leas_jax.navigate.loop import NavigateConfig
+
+    config = NavigateConfig()
+    return dataclasses.replace(
+        config, lattice=dataclasses.replace(config.lattice, walkability=args.navigate_walkability)
+    )
+
+
 def register(subparsers) -> None:
     from leas_jax.arguments import add_ray_address_argument
 
@@ -223,6 +238,13 @@ def register(subparsers) -> None:
         help="s between the poses of RBKino's and RBKino+RRT's paths handed to the contact generator "
         "(default 0.01, as HPP's generator samples a path; 0.1, the env's, costs about a third of the "
         "contact planning but the generator then cannot follow RBKino's turns from starts turned away)",
+    )
+    parser.add_argument(
+        "--navigate-walkability",
+        metavar="WEIGHTS.npz",
+        default=None,
+        help="the navigate method's lattice judges confident ground with this walkability model "
+        "(`leas feasibility walkability`; default: the policy's reachability condition)",
     )
     parser.add_argument(
         "--motion",

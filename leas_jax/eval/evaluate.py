@@ -226,9 +226,10 @@ def _leas_guides(
 
 
 def _navigate_trajectories(
-    policy, terrain, starts: Starts, points: np.ndarray, workers: int, address, progress: bool
+    policy, terrain, starts: Starts, points: np.ndarray, workers: int, address, progress: bool, config=None
 ) -> tuple[list, dict]:
-    """Navigate from every start through the route `points` (closed loop, its own pool).
+    """Navigate from every start through the route `points` (closed loop, its own pool;
+    `config`: a `NavigateConfig`, None for its defaults).
 
     Returns:
         ([(guide or None, waypoints, outcome, replans, plan or None)] per start, seconds per
@@ -236,9 +237,9 @@ def _navigate_trajectories(
     """
     from tqdm.auto import tqdm
 
-    from leas_jax.navigate.loop import Navigator
+    from leas_jax.navigate.loop import NavigateConfig, Navigator
 
-    navigator = Navigator(policy, terrain)
+    navigator = Navigator(policy, terrain, config or NavigateConfig())
     queries = [
         navigator.query(pose, points[-1], float(speed), points[:-1])
         for pose, speed in zip(starts.poses, starts.speeds)
@@ -275,6 +276,7 @@ def build_trajectories(
     rrt_workers: int = 0,
     leas_stop_at_invalid: bool = False,
     address: str | None = None,
+    navigate_config=None,
 ) -> tuple[list[Trajectory], dict]:
     """Starts and guides of every cell and method of one scenario (no validation yet, except
     navigate's: its closed loop validates, its trajectories come with their outcome).
@@ -383,7 +385,7 @@ def build_trajectories(
         if "navigate" in methods:
             began = time.perf_counter()
             answers, parts = _navigate_trajectories(
-                policy, terrain, starts, points, rrt_workers, address, progress
+                policy, terrain, starts, points, rrt_workers, address, progress, navigate_config
             )
             for n, (guide, waypoints, outcome, replans, plan) in enumerate(answers):
                 trajectories.append(
@@ -496,6 +498,7 @@ def run_scenario(
     progress: bool = True,
     address: str | None = None,
     leas_stop_at_invalid: bool = False,
+    navigate_config=None,
 ) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
@@ -512,6 +515,7 @@ def run_scenario(
         address: a Ray cluster address for the contact generator (None: local processes).
         leas_stop_at_invalid: LeaS paths end before the first pose the reachability
             condition rejects (False: the contact generator alone judges them).
+        navigate_config: `NavigateConfig` of the navigate method (None: its defaults).
     """
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
@@ -540,6 +544,7 @@ def run_scenario(
         rrt_workers=workers or 0,
         leas_stop_at_invalid=leas_stop_at_invalid,
         address=address,
+        navigate_config=navigate_config,
     )
     began = time.perf_counter()
     validate(
@@ -570,6 +575,7 @@ def evaluate(
     leas_stop_at_invalid: bool = False,
     rbkino_timestep: float | None = None,
     motion_plans: int = 0,
+    navigate_config=None,
 ) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
@@ -601,6 +607,7 @@ def evaluate(
         motion_plans: per scenario and method among leas and navigate, make at most this
             many plans that cover their guide into motions and simulate them in MuJoCo
             (`leas_jax.eval.motions`; results.json's `motion`, table.md's motion table; 0: none).
+        navigate_config: `NavigateConfig` of the navigate method (None: its defaults).
 
     Returns:
         the results dictionary written to results.json.
@@ -648,6 +655,7 @@ def evaluate(
                 progress=progress,
                 address=address,
                 leas_stop_at_invalid=leas_stop_at_invalid,
+                navigate_config=navigate_config,
             )
         )
         if motion_plans > 0:

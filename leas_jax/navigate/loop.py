@@ -166,7 +166,8 @@ class Navigator:
             nx, ny, nh = self._lattice.shape
             self.say(
                 f"lattice: {nx} x {ny} cells x {nh} headings at {cfg.lattice.resolution:g} m, "
-                f"{100 * self._lattice.node_valid.mean():.1f} % valid ({self.lattice_seconds:.2f} s)"
+                f"{100 * self._lattice.node_valid.mean():.1f} % valid, {100 * self._lattice.doubtful.mean():.1f} % "
+                f"doubtful ({self.lattice_seconds:.2f} s)"
             )
         return self._lattice
 

@@ -2,7 +2,8 @@
 intervals, coverage, navigate's replans and the reasons it stops.
 
     python docs/results/2026-12-06-rough-scenes/summarise.py FOLDER
-reads FOLDER/eval/*/results.json, writes FOLDER/summary.json and FOLDER/summary.md.
+reads FOLDER/*/*/results.json (eval/ and baselines/), writes FOLDER/summary.json and
+FOLDER/summary.md, rows sorted by scene then method.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ def scene_rows(results: dict) -> list[dict]:
 
 def table(rows: list[dict]) -> str:
     lines = [
-        "| scene | method | n | success % [95 % CI] | coverage % | replans (mean) | s |",
+        "| scene | method | n | success % [95 % CI] | coverage % | replans (mean) | guide s |",
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -59,8 +60,10 @@ def table(rows: list[dict]) -> str:
 
 def main(folder: Path) -> None:
     rows = []
-    for path in sorted((folder / "eval").glob("*/results.json")):
+    for path in sorted(folder.glob("*/*/results.json")):
         rows += scene_rows(json.loads(path.read_text()))
+    rank = {m: k for k, m in enumerate(ORDER)}
+    rows.sort(key=lambda r: (r["scene"], rank.get(r["method"], len(ORDER))))
     (folder / "summary.json").write_text(json.dumps(rows, indent=1) + "\n")
     (folder / "summary.md").write_text(table(rows))
     print(table(rows), end="")

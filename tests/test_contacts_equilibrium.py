@@ -123,3 +123,17 @@ def test_missing_library_message(monkeypatch):
     monkeypatch.setattr(E.site, "getusersitepackages", lambda: "/nonexistent-user")
     with pytest.raises(ImportError, match="libhpp-centroidal-dynamics.so"):
         E._cmeel_lib_dir()
+
+
+def test_an_accelerating_com_keeps_the_clp_retry_and_rest_is_zero_acceleration():
+    """The stairs15 stances that qpOASES fails cold are solved with a CoM acceleration too (the
+    motion checks' call), and a zero acceleration gives the robustness at rest."""
+    data = np.load(STAIRS15)
+    solver = E.HppEquilibrium(MASS)
+    for feet, com in zip(data["feet"], data["com"]):
+        points, normals = E.sole_corners(feet)
+        solver.set_contacts(points, normals)
+        at_rest = solver.robustness(com)
+        assert np.isfinite(at_rest)
+        assert solver.robustness(com, np.zeros(3)) == pytest.approx(at_rest, rel=1e-6)
+        assert solver.robustness(com, np.array([30.0, 30.0, 0.0])) < at_rest  # pushed sideways: less margin

@@ -866,9 +866,4 @@ def _robustness(solver, feet: np.ndarray, com: np.ndarray, acceleration: np.ndar
     if len(points) == 0:
         return -np.inf
     solver.set_contacts(points, normals)
-    status, value = solver._eq.computeEquilibriumRobustness(
-        np.asarray(com, dtype=np.float64), np.asarray(acceleration, dtype=np.float64)
-    )
-    if status != solver._hpp.LP_status.LP_STATUS_OPTIMAL:
-        return -np.inf
-    return float(value)
+    return solver.robustness(com, acceleration)

@@ -172,19 +172,22 @@ class HppEquilibrium:
             self._clp_key = self._contacts_key
         return self._clp
 
-    def robustness(self, com: np.ndarray) -> float:
-        """Robustness of the current contact set for a CoM [3] (world); -inf if the LP has no optimum.
+    def robustness(self, com: np.ndarray, acceleration: np.ndarray | None = None) -> float:
+        """Robustness of the current contact set for a CoM [3] (world), at rest or accelerating
+        [3] (m/s^2, world); -inf if the LP has no optimum.
 
         Raises:
             RuntimeError: no contact set yet (`set_contacts`).
         """
         if self._contacts is None:
             raise RuntimeError("no contact set: call set_contacts first")
-        com = np.asarray(com, dtype=np.float64)
+        args = (np.asarray(com, dtype=np.float64),)
+        if acceleration is not None:
+            args += (np.asarray(acceleration, dtype=np.float64),)
         optimal = self._hpp.LP_status.LP_STATUS_OPTIMAL
-        status, value = self._eq.computeEquilibriumRobustness(com)
+        status, value = self._eq.computeEquilibriumRobustness(*args)
         if status != optimal and not self.use_clp:
-            status, value = self._clp_equilibrium().computeEquilibriumRobustness(com)
+            status, value = self._clp_equilibrium().computeEquilibriumRobustness(*args)
         return float(value) if status == optimal else -np.inf
 
     def feet_robustness(self, feet: np.ndarray, com: np.ndarray) -> float:

@@ -8,13 +8,12 @@ loop does, not where the real generator does (tests/test_navigate_cli.py runs th
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
+from navigate_helpers import plan_until
 
-from leas_jax.contacts.plan import coverage_of
 from leas_jax.contacts.validation.pool import ValidationPool
 from leas_jax.navigate import result as reasons
 from leas_jax.navigate.lattice import build_lattice, heading_index
@@ -54,23 +53,10 @@ size = [6.0, 4.0, 0.6]
 """
 
 
-@dataclass(frozen=True)
-class StandInPlan:
-    """What metrics and the loop read of a plan: posture roots, coverage, last valid index."""
-
-    q: np.ndarray
-    coverage: float
-    last_valid_index: int
-
-
 def blocked_plan(terrain, guide, timestep, config):
     """Covers a guide up to the pose before it enters the disk BLOCK_RADIUS around BLOCK."""
     inside = np.flatnonzero(np.hypot(*(guide[:, :2] - BLOCK).T) < BLOCK_RADIUS)
-    last = len(guide) - 1 if len(inside) == 0 else max(int(inside[0]) - 1, 0)
-    picks = np.unique(np.append(np.arange(0, last + 1, 5), last))
-    q = np.zeros((len(picks), 39))
-    q[:, :3] = guide[picks, :3]
-    return StandInPlan(q, coverage_of(guide, last), last)
+    return plan_until(guide, len(guide) - 1 if len(inside) == 0 else max(int(inside[0]) - 1, 0))
 
 
 @pytest.fixture(scope="module")

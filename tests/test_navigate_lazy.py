@@ -8,13 +8,12 @@ loop does with the verdicts, in seconds.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
+from navigate_helpers import plan_until
 
-from leas_jax.contacts.plan import coverage_of
 from leas_jax.contacts.validation.pool import ValidationPool
 from leas_jax.navigate import result as reasons
 from leas_jax.navigate.lattice import LatticeConfig, build_lattice, heading_index
@@ -185,31 +184,15 @@ def test_astar_finds_dijkstras_cost_and_path_length(policy):
         assert found.reached and found.cost == pytest.approx(best, rel=1e-9, abs=1e-9)
 
 
-@dataclass(frozen=True)
-class StandInPlan:
-    """What metrics and the loop read of a plan: posture roots, coverage, last valid index."""
-
-    q: np.ndarray
-    coverage: float
-    last_valid_index: int
-
-
-def _plan_until(guide, last: int) -> StandInPlan:
-    picks = np.unique(np.append(np.arange(0, last + 1, 5), last))
-    q = np.zeros((len(picks), 39))
-    q[:, :3] = guide[picks, :3]
-    return StandInPlan(q, coverage_of(guide, last), last)
-
-
 def walks_everything(terrain, guide, timestep, config):
     """A generator that covers every guide."""
-    return _plan_until(guide, len(guide) - 1)
+    return plan_until(guide, len(guide) - 1)
 
 
 def refuses_the_tiles(terrain, guide, timestep, config):
     """A generator that stops before the first guide pose on the rough strip."""
     inside = np.flatnonzero((guide[:, 0] > ROUGH_X[0]) & (guide[:, 0] < ROUGH_X[1]))
-    return _plan_until(guide, len(guide) - 1 if len(inside) == 0 else max(int(inside[0]) - 1, 0))
+    return plan_until(guide, len(guide) - 1 if len(inside) == 0 else max(int(inside[0]) - 1, 0))
 
 
 def _navigate(policy, plan_fn, **config):

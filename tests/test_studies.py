@@ -130,3 +130,22 @@ def test_table2_rbkino_sampled_as_hpp_follows_a_start_turned_away():
     table2.judge(terrain, [coarse, fine], base.timestep, 0, None)
     assert coarse.outcome.last_valid_index == 0
     assert fine.outcome.coverage == 1.0 and fine.outcome.success
+
+
+def test_generator_rough_scenes_builds_its_limit_terrains_and_guides():
+    import generator_rough_scenes as grs
+    import numpy as np
+
+    from leas_jax.terrain import loads_terrain
+
+    gap = loads_terrain(grs._limit_terrain("gap", 0.4))
+    assert gap.height_at(np.array([[3.2, 1.0]]))[0] == pytest.approx(gap.void_height)
+    assert gap.height_at(np.array([[3.5, 1.0]]))[0] == pytest.approx(0.0, abs=1e-6)
+    down = loads_terrain(grs._limit_terrain("down", 0.25))
+    assert down.height_at(np.array([[2.0, 1.0], [4.0, 1.0]])) == pytest.approx([0.25, 0.0], abs=1e-6)
+    field = heightfield_from_terrain(down, EnvConfig(condition="cylinders"))
+    guide = grs.straight_guide(field, (1.5, 1.0), (4.5, 1.0), 0.18, 1.0)
+    assert np.allclose(np.diff(guide[:, 0]), 3.0 / (len(guide) - 1)) and np.allclose(guide[:, 3], 0.0)
+    assert guide[0, 2] == pytest.approx(1.25, abs=1e-3) and guide[-1, 2] == pytest.approx(1.0, abs=1e-3)
+    rows = [{"kind": "gap", "size": 0.4, "covered": True}, {"kind": "gap", "size": 0.5, "covered": False}]
+    assert "| gap across | 0.40 | 0.50 |" in grs.limits_table(rows)

@@ -88,7 +88,7 @@ def test_a_known_rule_is_learned_from_synthetic_labels():
 
     def labelled(family, seed):
         terrain, field = _field(family_terrain(family, seed))
-        poses = wk.plausible_poses(terrain, 400, seed, CONFIG)
+        poses, _ = wk.plausible_poses(field, terrain.bounds, 400, seed, CONFIG)
         x = features_of(params, field, poses, reach)
         return x, x[:, : len(grid)][:, ahead].max(axis=1) > -CONFIG.nominal_root_height + 0.05
 

@@ -36,6 +36,7 @@ environment's termination condition (these cylinders or the learned one).
 """
 
 import dataclasses
+import functools
 
 import jax
 import jax.numpy as jnp
@@ -148,8 +149,12 @@ def terms(field: Heightfield, pose: jax.Array, config: ReachabilityConfig = Reac
 def valid(
     field: Heightfield, pose: jax.Array, config: ReachabilityConfig = ReachabilityConfig()
 ) -> jax.Array:
-    """True when the root pose satisfies the reachability condition. pose: [4] -> bool[]."""
-    return jnp.all(jnp.stack(list(terms(field, pose, config).values())))
+    """True when the root pose satisfies the reachability condition. pose: [4] -> bool[].
+
+    A chain of ands rather than `all` over the stacked terms: the disabled terms' constant True
+    fold away, where stacked, XLA spent seconds constant-folding them over large vmapped batches
+    (a 65 536-pose chunk of the navigate lattice)."""
+    return functools.reduce(jnp.logical_and, terms(field, pose, config).values())
 
 
 MARGIN_CLIP = 1.0  # m, |margin| kept (an infinite raster value, e.g. no solid ground, reads as 1 m)

@@ -85,12 +85,6 @@ def crack_filled_ground(field, crack_width: float) -> np.ndarray:
     return solid | ndimage.binary_closing(padded, structure=disk)[radius:-radius, radius:-radius]
 
 
-def _all_terms(field, pose: jax.Array, reach) -> jax.Array:
-    """`reachability.valid` as a chain of ands: the disabled terms' constant True fold away
-    (stacked, XLA spends seconds constant-folding them over a 65 536-pose chunk)."""
-    return functools.reduce(jnp.logical_and, reachability.terms(field, pose, reach).values())
-
-
 @functools.partial(jax.jit, static_argnums=(3, 4, 5))
 def judge(
     field, ground_ok: jax.Array, planar: jax.Array, nominal_root_height: float, confident, plausible, model
@@ -122,9 +116,9 @@ def judge(
     solid = jnp.isfinite(ground) & sample_nearest(field, ground_ok, planar[:, :2], outside=False)
     z = jnp.where(solid, ground, field.void_height) + nominal_root_height
     poses = jnp.stack([planar[:, 0], planar[:, 1], z, planar[:, 2]], axis=1)
-    maybe = jax.vmap(lambda pose: _all_terms(field, pose, plausible))(poses) & solid
+    maybe = jax.vmap(lambda pose: reachability.valid(field, pose, plausible))(poses) & solid
     if model is None:
-        sure = jax.vmap(lambda pose: _all_terms(field, pose, confident))(poses) & solid
+        sure = jax.vmap(lambda pose: reachability.valid(field, pose, confident))(poses) & solid
     else:
         sure = maybe & (
             jax.vmap(lambda pose: lf.logit(model, field, pose, confident))(poses) >= model["threshold"]
@@ -195,14 +189,22 @@ def _field(terrain):
     return heightfield_from_terrain(terrain, EnvConfig(condition="cylinders"))
 
 
-def plausible_poses(terrain, count: int, seed: int, config: WalkabilityConfig, band=FEATURE_X) -> np.ndarray:
-    """[k <= count, 4] (x, y, z, yaw) plausible poses on a terrain, seeded: x over `band` +- 0.5 m
-    for `feature_fraction` of the draws (None: all over the terrain), the rest anywhere 0.3 m
-    inside the bounds; yaw uniform; z as the lattice sets it (`judge`)."""
+def plausible_poses(field, bounds, count: int, seed: int, config: WalkabilityConfig, band=FEATURE_X):
+    """Plausible root poses on a terrain, seeded: x over `band` +- 0.5 m for `feature_fraction` of
+    the draws (None: all over the terrain), the rest anywhere 0.3 m inside `bounds` [[x0, y0],
+    [x1, y1]]; yaw uniform; z as the lattice sets it (`judge`).
+
+    Args:
+        field: the terrain's heightfield with the calibrated cylinders' rasters (`_field`).
+
+    Returns:
+        (poses [k <= count, 4] (x, y, z, yaw), cylinders [k] bool: the calibrated cylinders'
+        verdict on each, the confident set without a model).
+    """
     from leas_jax.env.config import ReachabilityConfig
 
     rng = np.random.default_rng(seed)
-    (x0, y0), (x1, y1) = np.asarray(terrain.bounds) + np.array([[0.3, 0.3], [-0.3, -0.3]])
+    (x0, y0), (x1, y1) = np.asarray(bounds) + np.array([[0.3, 0.3], [-0.3, -0.3]])
     near = 0 if band is None else int(round(config.feature_fraction * count))
     xs = np.concatenate(
         [
@@ -211,9 +213,8 @@ def plausible_poses(terrain, count: int, seed: int, config: WalkabilityConfig, b
         ]
     )
     planar = np.column_stack([xs, rng.uniform(y0, y1, count), rng.uniform(-np.pi, np.pi, count)])
-    field = _field(terrain)
     reach = ReachabilityConfig()
-    z, _, maybe = judge_poses(
+    z, cylinders, maybe = judge_poses(
         field,
         crack_filled_ground(field, config.crack_width),
         planar,
@@ -223,7 +224,7 @@ def plausible_poses(terrain, count: int, seed: int, config: WalkabilityConfig, b
         None,
         chunk=1024,
     )
-    return np.column_stack([planar[:, :2], z, planar[:, 2]])[maybe]
+    return np.column_stack([planar[:, :2], z, planar[:, 2]])[maybe], cylinders[maybe]
 
 
 _WORKER = {}
@@ -284,19 +285,14 @@ def labelled_terrain(
     terrain, group: str, count: int, seed: int, config, cache, workers, grid_params, band=FEATURE_X
 ):
     """`LabelledSet` of `count` draws of plausible poses on one terrain."""
-    from leas_jax.env import reachability as cyl
     from leas_jax.env.config import ReachabilityConfig
     from leas_jax.feasibility.fit import features_of
 
-    poses = plausible_poses(terrain, count, seed, config, band)
     field = _field(terrain)
-    reach = ReachabilityConfig()
+    poses, cylinders = plausible_poses(field, terrain.bounds, count, seed, config, band)
     labels = walking_labels(terrain, poses, cache, workers)
-    valid = np.asarray(
-        jax.jit(jax.vmap(lambda p: cyl.valid(field, p, reach)))(jnp.asarray(poses, jnp.float32))
-    )
-    x = features_of(grid_params, field, poses, reach)
-    return LabelledSet(x, labels, valid.astype(bool), np.full(len(poses), group))
+    x = features_of(grid_params, field, poses, ReachabilityConfig())
+    return LabelledSet(x, labels, cylinders, np.full(len(poses), group))
 
 
 def concatenate(sets) -> LabelledSet:

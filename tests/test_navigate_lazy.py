@@ -38,22 +38,17 @@ def _tiles(width_y: float, y0: float) -> str:
     return "\n".join(out)
 
 
+def _terrain(name: str, boxes: list[tuple[float, float, float, float]], extra: str = "") -> str:
+    """An 8 x 3 m terrain of full-width boxes (x centre, z centre, x size, z size), then `extra`."""
+    text = f'name = "{name}"\nbounds = [[0.0, 0.0], [8.0, 3.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
+    for x, z, size_x, size_z in boxes:
+        text += f"[[box]]\ncenter = [{x}, 1.5, {z}]\nsize = [{size_x}, 3.0, {size_z}]\n"
+    return text + extra
+
+
 def _slab(name: str, tiles: str, extra: str = "") -> str:
     """An 8 x 3 m slab with its top at 0, a gap for the tiles in ROUGH_X over the full width."""
-    return f"""
-name = "{name}"
-bounds = [[0.0, 0.0], [8.0, 3.0]]
-void_height = -2.0
-resolution = 0.02
-[[box]]
-center = [1.5, 1.5, -0.1]
-size = [3.0, 3.0, 0.2]
-[[box]]
-center = [6.1, 1.5, -0.1]
-size = [3.8, 3.0, 0.2]
-{tiles}
-{extra}
-"""
+    return _terrain(name, [(1.5, -0.1, 3.0, 0.2), (6.1, -0.1, 3.8, 0.2)], f"{tiles}\n{extra}\n")
 
 
 # The tiles cover the whole width: every way to the goal crosses doubtful ground.
@@ -65,34 +60,14 @@ ROUGH_WITH_LANE = _slab(
     "[[box]]\ncenter = [3.6, 2.6, -0.1]\nsize = [1.2, 0.8, 0.2]\n",
 )
 
-STEPS = """
-name = "steps"
-bounds = [[0.0, 0.0], [8.0, 3.0]]
-void_height = -2.0
-resolution = 0.02
-[[box]]
-center = [4.0, 1.5, -0.1]
-size = [8.0, 3.0, 0.2]
-[[box]]
-center = [5.0, 1.5, {half}]
-size = [6.0, 3.0, {height}]
-"""
 
-CRACKS = """
-name = "cracks"
-bounds = [[0.0, 0.0], [8.0, 3.0]]
-void_height = -2.0
-resolution = 0.02
-[[box]]
-center = [1.5, 1.5, -0.1]
-size = [3.0, 3.0, 0.2]
-[[box]]
-center = [3.53, 1.5, -0.1]
-size = [1.0, 3.0, 0.2]
-[[box]]
-center = [6.0, 1.5, -0.1]
-size = [3.0, 3.0, 0.2]
-"""  # a 0.06 m crack at x 3.0..3.06, a 0.47 m gap at x 4.03..4.5
+def _steps(height: float) -> str:
+    """Flat ground with a step of `height` m up at x = 2 across the whole width."""
+    return _terrain("steps", [(4.0, -0.1, 8.0, 0.2), (5.0, height / 2, 6.0, height)])
+
+
+# a 0.06 m crack at x 3.0..3.06, a 0.47 m gap at x 4.03..4.5
+CRACKS = _terrain("cracks", [(1.5, -0.1, 3.0, 0.2), (3.53, -0.1, 1.0, 0.2), (6.0, -0.1, 3.0, 0.2)])
 
 
 @pytest.fixture(scope="module")
@@ -151,7 +126,7 @@ def test_a_confident_detour_is_preferred_to_doubtful_ground(policy):
 
 @pytest.mark.parametrize("height, crosses", [(0.15, True), (0.40, False)])
 def test_the_step_model_bounds_a_riser(policy, height, crosses):
-    terrain = loads_terrain(STEPS.format(half=height / 2, height=height))
+    terrain = loads_terrain(_steps(height))
     lattice = _lattice(policy, terrain)
     assert _valid_at(lattice, (1.0, 1.5)) and _valid_at(lattice, (6.0, 1.5)), "both treads"
     found = search(lattice, (1.0, 1.5, 0.0), (6.0, 1.5))

@@ -49,3 +49,24 @@ def test_soft_legs_fall_in_single_support(motion):
     assert not rollout.success
     failing = [p for p in rollout.phases if p.problems(SimulationConfig())]
     assert failing and failing[0].kind in ("lift", "land", "shift")
+
+
+def test_peak_torque_ratio_per_joint_group(motion):
+    """Every joint's peak commanded torque over its limit is kept; the groups partition the 32
+    joints, the legs carry the largest ratio on flat ground and the run's CPU time is measured."""
+    from leas_jax.contacts.robot.model import load_talos
+    from leas_jax.motion.simulate import JOINT_GROUPS
+
+    rollout = simulate(motion, config=SimulationConfig(settle=0.0))
+    names = [load_talos().model.names[i] for i in range(2, 34)]
+    assert sorted(i for group in JOINT_GROUPS.values() for i in group) == list(range(32))
+    for group, index in JOINT_GROUPS.items():
+        prefix = {"legs": "leg_", "torso": "torso_", "arms": "arm_", "grippers": "gripper_", "head": "head_"}[
+            group
+        ]
+        assert all(names[i].startswith(prefix) for i in index), (group, [names[i] for i in index])
+    ratios = rollout.group_torque_ratios()
+    assert rollout.joint_torque_ratio.shape == (32,) and (rollout.joint_torque_ratio > 0).all()
+    assert max(ratios.values()) == pytest.approx(max(p.torque_ratio for p in rollout.phases))
+    assert ratios["legs"] == max(ratios.values()) < 1.0
+    assert 0.0 < rollout.cpu_seconds

@@ -24,12 +24,14 @@ class Execution:
         rollout: the `simulate` result (None when there is no motion).
         error: `MotionError`'s message (the phase and why), None when the motion was made.
         make_seconds: wall-clock time of `make_motion`, s.
+        make_cpu_seconds: CPU time of this process in `make_motion`, s (NaN: not measured).
     """
 
     motion: object | None
     rollout: object | None
     error: str | None
     make_seconds: float
+    make_cpu_seconds: float = math.nan
 
     @property
     def success(self) -> bool:
@@ -47,12 +49,15 @@ class Execution:
         Keys: made, error, success, fallen, fall_time_s, phases, phases_reached,
         max_landing_position_m (sole position error at landing, world), max_landing_angle_deg,
         max_slip_m (horizontal, supporting sole), max_torque_ratio (commanded / effort limit),
-        duration_s (motion), make_seconds, simulate_seconds, message.
+        torque_ratio_by_group (the same per joint group of `simulate.JOINT_GROUPS`),
+        duration_s (motion), make_seconds, make_cpu_seconds, simulate_seconds,
+        simulate_cpu_seconds, message.
         """
         out = {
             "made": self.motion is not None,
             "error": self.error,
             "make_seconds": round(self.make_seconds, 3),
+            "make_cpu_seconds": _rounded(self.make_cpu_seconds, 3),
         }
         if self.rollout is None:
             return out | {"success": False, "fallen": None}
@@ -67,8 +72,12 @@ class Execution:
             "max_landing_angle_deg": _rounded(figures["max_landing_angle_deg"]),
             "max_slip_m": _rounded(figures["max_slip_m"]),
             "max_torque_ratio": _rounded(figures["max_torque_ratio"]),
+            "torque_ratio_by_group": {
+                name: round(value, 4) for name, value in self.rollout.group_torque_ratios().items()
+            },
             "duration_s": round(self.motion.duration, 3),
             "simulate_seconds": round(self.rollout.seconds, 3),
+            "simulate_cpu_seconds": _rounded(self.rollout.cpu_seconds, 3),
             "message": self.rollout.message,
         }
         return out
@@ -122,10 +131,12 @@ def execute_plan(
     from leas_jax.motion.motion import MotionError, make_motion
     from leas_jax.motion.simulate import simulate
 
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.process_time()
     try:
         motion = make_motion(plan, motion_config)
     except MotionError as exc:
-        return Execution(None, None, str(exc), time.perf_counter() - started)
-    seconds = time.perf_counter() - started
-    return Execution(motion, simulate(motion, config=simulation_config), None, seconds)
+        return Execution(
+            None, None, str(exc), time.perf_counter() - started, time.process_time() - cpu_started
+        )
+    seconds, cpu_seconds = time.perf_counter() - started, time.process_time() - cpu_started
+    return Execution(motion, simulate(motion, config=simulation_config), None, seconds, cpu_seconds)

@@ -89,7 +89,10 @@ class Rollout:
         q: [M, 39] simulated Pinocchio configurations at those times.
         root_height: [M] base_link height over the highest supporting sole, m.
         tilt: [M] angle between base_link's z axis and world z, rad.
+        joint_torque_ratio: [32] largest |commanded torque| / effort limit of each joint over
+            the run, before clipping (Pinocchio joint order, `JOINT_GROUPS`).
         seconds: wall-clock time of the simulation, s.
+        cpu_seconds: CPU time of this process during the simulation, s.
         message: one line: success, or the first failing phase and why.
     """
 
@@ -103,6 +106,14 @@ class Rollout:
     tilt: np.ndarray
     seconds: float
     message: str
+    joint_torque_ratio: np.ndarray = field(default_factory=lambda: np.zeros(32))
+    cpu_seconds: float = math.nan
+
+    def group_torque_ratios(self) -> dict:
+        """Largest |commanded torque| / effort limit per joint group of `JOINT_GROUPS`."""
+        return {
+            name: float(self.joint_torque_ratio[list(index)].max()) for name, index in JOINT_GROUPS.items()
+        }
 
     def summary(self) -> dict:
         """Figures of the rollout: phases reached, worst landing, slip and torque ratio."""
@@ -120,6 +131,18 @@ class Rollout:
             "max_torque_ratio": max((p.torque_ratio for p in self.phases), default=math.nan),
             "seconds": self.seconds,
         }
+
+
+# Talos's actuated joints by group, as indices into the 32 joints in Pinocchio's order
+# (leg_left_1..6, leg_right_1..6, torso_1..2, arm_left_1..7, gripper_left, arm_right_1..7,
+# gripper_right, head_1..2).
+JOINT_GROUPS = {
+    "legs": tuple(range(0, 12)),
+    "torso": (12, 13),
+    "arms": tuple(range(14, 21)) + tuple(range(22, 29)),
+    "grippers": (21, 29),
+    "head": (30, 31),
+}
 
 
 def pd_gains(mj, talos, config: SimulationConfig) -> tuple[np.ndarray, np.ndarray]:
@@ -184,7 +207,7 @@ def simulate(
     from leas_jax.terrain import loads_terrain
     from leas_jax.terrain.export import terrain_to_mjcf
 
-    started = clock.perf_counter()
+    started, cpu_started = clock.perf_counter(), clock.process_time()
     if terrain is None:
         terrain = loads_terrain(motion.terrain, source="<motion terrain>")
     mj = scene_model(terrain_to_mjcf(terrain), config.timestep)
@@ -205,6 +228,7 @@ def simulate(
     phase_index, fall_time = 0, math.nan
     q_joint, dq_joint = mj.qpos_index, mj.dof_index
     actuators = mj.actuator_index
+    joint_ratio = np.zeros(len(effort))
     for step in range(steps + 1):
         position = min(step / stride, len(motion.q) - 1)
         sample = int(position)
@@ -219,7 +243,9 @@ def simulate(
         if feedforward:
             command += _interpolate(motion.tau, position)
         command *= torque_scale
-        result.torque_ratio = max(result.torque_ratio, float(np.max(np.abs(command) / effort)))
+        ratio = np.abs(command) / effort
+        np.maximum(joint_ratio, ratio, out=joint_ratio)
+        result.torque_ratio = max(result.torque_ratio, float(ratio.max()))
         data.ctrl[actuators] = np.clip(command, -effort, effort)
         contact = motion.contact[min(sample + 1, len(motion.q) - 1)] & motion.contact[sample]
         for side in (0, 1):
@@ -271,6 +297,8 @@ def simulate(
         tilt=np.array(record_tilt),
         seconds=clock.perf_counter() - started,
         message=message,
+        joint_torque_ratio=joint_ratio,
+        cpu_seconds=clock.process_time() - cpu_started,
     )
 
 

@@ -1,0 +1,324 @@
+"""Do verified contact plans execute in MuJoCo, within Talos's effort limits, and how fast?
+
+Question: what fraction of the contact generator's verified plans does Talos execute in
+MuJoCo physics (`leas_jax.motion.execute.execute_plan`: `make_motion`, then `simulate`)
+without a fall and with every sole landing within 3 cm of its placement; how close do the
+commanded torques come to the URDF's effort limits (peak ratio per joint group); and how
+much CPU time do motion generation and simulation cost per second of motion?
+
+Plans: each scenario's seeded starts (as `leas evaluate` draws them; `ground` is Table II's
+nine cells of yaw range x initial speed, `--starts` per cell there) steered by RBLin
+(straight lines to the target, `leas_jax.steering.baselines`) and planned by the contact
+generator in this process; a plan counts when it covers its whole guide (the generator's
+verified plans, `leas_jax.eval.motions.covers_guide`). The HPP group's demo queries
+(terrains/hpp/demos/*.toml) hold one start each. Plans are cached in
+`<plans>/<scenario>_<k>.npz` (default runs/motion_plans/, not committed), so a later run
+(another `--variant`) executes the same plans.
+
+Execution: one process, one plan at a time. Per plan: made (or the `MotionError` phase and
+reason), fallen (and in which phase kind), success (every phase passes `simulate`'s checks:
+landings within 3 cm / 5 deg, slip under 1 cm, torques within limits, no other terrain
+contact), the largest landing error, the peak torque ratio per joint group, the motion's
+duration and the CPU time (`time.process_time`) of `make_motion` and of `simulate`.
+Rates come with 95 % Wilson intervals.
+
+    python studies/motion_execution.py --out docs/results/2026-12-06-motion --starts 4 --ground-starts 1 --all
+    python studies/motion_execution.py --out docs/results/2026-12-06-motion --variant baseline \\
+        --motion-config '{"support_margin": 0.0}'
+
+Writes <out>/motion_execution_<variant>.json and <out>/motion_execution_<variant>.md.
+
+Results: --out (default benchmarks/results/motion); the run kept is docs/results/2026-12-06-motion/.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# The target group (90 %): Table II's flat ground, eval_stairs, eval_bridge and two HPP demos.
+TARGET = ("ground", "stairs", "bridge", "hpp_talos_stairs10", "hpp_talos_navBauzil")
+# The other evaluation scenarios and HPP scenes (75 % over all scenes with a verified plan).
+OTHERS = ("hole", "stairs_side", "hpp_stairs", "hpp_bridge", "hpp_hole", "hpp_talos_flatGround")
+# Scenario name -> terrain file for the HPP scenes (the evaluation scenarios by name).
+HPP_FILES = {
+    "hpp_talos_stairs10": "terrains/hpp/demos/talos_stairs10.toml",
+    "hpp_talos_navBauzil": "terrains/hpp/demos/talos_navBauzil.toml",
+    "hpp_talos_flatGround": "terrains/hpp/demos/talos_flatGround.toml",
+    "hpp_stairs": "terrains/hpp/stairs.toml",
+    "hpp_bridge": "terrains/hpp/bridge.toml",
+    "hpp_hole": "terrains/hpp/hole.toml",
+}
+
+
+def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a binomial rate (0, 1 when n is 0)."""
+    if n == 0:
+        return 0.0, 1.0
+    p = successes / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def make_plans(name: str, starts: int, ground_starts: int, cache: Path) -> list[Path]:
+    """Plan files of `name`'s covered RBLin plans, planned now unless cached.
+
+    Args:
+        name: an evaluation scenario (`leas_jax.eval.scenarios.SCENARIOS`) or a key of HPP_FILES.
+        starts: starts of a one-cell scenario (HPP demos: their one start).
+        ground_starts: starts per cell of `ground` (Table II's nine cells).
+        cache: folder of the plan files.
+
+    Returns:
+        paths of the covered plans' files (world frame, the generator's ContactPlan format).
+    """
+    from leas_jax.eval.evaluate import run_scenario
+    from leas_jax.eval.motions import covers_guide
+    from leas_jax.terrain import load_terrain
+    from leas_jax.terrain.generate import scenario_file
+
+    marker = cache / f"{name}.json"
+    if marker.is_file():
+        return [cache / f for f in json.loads(marker.read_text())["plans"]]
+    terrain = load_terrain(ROOT / HPP_FILES[name] if name in HPP_FILES else scenario_file(name))
+    began = time.perf_counter()
+    # ground: per cell of nine; the HPP demos: their one query; the other scenes: `starts`.
+    per_cell = ground_starts if name == "ground" else (None if name.startswith("hpp_talos") else starts)
+    result = run_scenario(name, terrain, ("rblin",), None, per_cell, 0, progress=False)
+    files = []
+    for k, trajectory in enumerate(result.trajectories):
+        if covers_guide(trajectory):
+            path = cache / f"{name}_{k}.npz"
+            trajectory.plan.save(path)
+            files.append(path.name)
+    marker.write_text(
+        json.dumps(
+            {
+                "starts": len(result.trajectories),
+                "plans": files,
+                "planning_seconds": round(time.perf_counter() - began, 1),
+            }
+        )
+    )
+    return [cache / f for f in files]
+
+
+def cause(summary: dict) -> str:
+    """The failure cause of one execution: 'no motion: <check>', 'fell in <phase kind>',
+    'landing > 3 cm', 'slip', 'torque clipped', 'terrain contact' (first that applies),
+    None when the plan executes."""
+    if not summary["made"]:
+        error = summary["error"] or ""
+        for key in ("equilibrium", "torque", "velocity", "joint limit", "IK", "terrain", "transition"):
+            if key.lower() in error.lower():
+                return f"no motion: {key}"
+        return "no motion: other"
+    if summary["success"]:
+        return None
+    message = summary["message"] or ""
+    if summary["fallen"]:
+        kind = message.split(" ", 1)[0] if message else "?"
+        return f"fell in {kind}"
+    if "cm from its placement" in message or "deg off" in message:
+        return "landing > 3 cm / 5 deg"
+    if "slips" in message:
+        return "slip"
+    if "x its limit" in message:
+        return "torque clipped"
+    if "terrain touched" in message:
+        return "terrain contact"
+    return "other"
+
+
+def run(args) -> dict:
+    from leas_jax.contacts.commands import load_plan_file
+    from leas_jax.motion.config import MotionConfig, SimulationConfig
+    from leas_jax.motion.execute import execute_plan
+
+    out = Path(args.out)
+    cache = Path(args.plans)
+    cache.mkdir(parents=True, exist_ok=True)
+    motion_config = MotionConfig(**json.loads(args.motion_config))
+    simulation_config = SimulationConfig(**json.loads(args.simulation_config))
+    names = list(TARGET) + (list(OTHERS) if args.all else [])
+    if args.scenarios:
+        names = args.scenarios.split(",")
+    report = {
+        "question": __doc__.split("\n\n")[1].replace("\n", " "),
+        "variant": args.variant,
+        "motion_config": json.loads(args.motion_config),
+        "simulation_config": json.loads(args.simulation_config),
+        "starts": args.starts,
+        "ground_starts_per_cell": args.ground_starts,
+        "scenarios": {},
+    }
+    json_path = out / f"motion_execution_{args.variant}.json"
+    for name in names:
+        plans = make_plans(name, args.starts, args.ground_starts, cache)
+        if args.max_plans:
+            plans = plans[: args.max_plans]
+        executions = []
+        for path in plans:
+            plan = load_plan_file(path)
+            s = execute_plan(plan, motion_config, simulation_config).summary()
+            s = {"plan": path.name, "postures": len(plan), "cause": None} | s
+            s["cause"] = cause(s)
+            executions.append(s)
+            print(
+                f"{name} {path.name}: {s['cause'] or 'executed'} ({s.get('message') or s['error']})",
+                flush=True,
+            )
+        marker = json.loads((cache / f"{name}.json").read_text())
+        report["scenarios"][name] = {
+            "starts": marker["starts"],
+            "verified_plans": len(marker["plans"]),
+            "executions": executions,
+        }
+        report["summary"] = summarise(report["scenarios"])
+        json_path.write_text(json.dumps(report, indent=1))
+    (out / f"motion_execution_{args.variant}.md").write_text(markdown(report))
+    return report
+
+
+def _rate(ok: int, n: int) -> dict:
+    low, high = wilson(ok, n)
+    return {
+        "ok": ok,
+        "n": n,
+        "rate": round(ok / n, 3) if n else None,
+        "wilson95": [round(low, 3), round(high, 3)],
+    }
+
+
+def summarise(scenarios: dict) -> dict:
+    """Per scenario and over the target group / all scenes: executed rates, causes, peaks, CPU ratios."""
+    rows, causes = {}, {}
+    groups = {"target": [], "all": []}
+    peaks: dict = {}
+    make_ratio, sim_ratio = [], []
+    for name, scenario in scenarios.items():
+        ex = scenario["executions"]
+        ok = sum(1 for e in ex if e["success"])
+        upright = sum(1 for e in ex if e["made"] and e["fallen"] is False)
+        rows[name] = {
+            "executed": _rate(ok, len(ex)),
+            "made_and_upright": _rate(upright, len(ex)),
+            "causes": {},
+        }
+        for e in ex:
+            if e["cause"]:
+                rows[name]["causes"][e["cause"]] = rows[name]["causes"].get(e["cause"], 0) + 1
+                causes[e["cause"]] = causes.get(e["cause"], 0) + 1
+            for group, value in (e.get("torque_ratio_by_group") or {}).items():
+                peaks[group] = max(peaks.get(group, 0.0), value)
+            if e["made"] and e.get("duration_s"):
+                make_ratio.append(e["make_cpu_seconds"] / e["duration_s"])
+                sim_ratio.append(e["simulate_cpu_seconds"] / e["duration_s"])
+        if ex:
+            groups["all"].append((ok, len(ex)))
+            if name in TARGET:
+                groups["target"].append((ok, len(ex)))
+    totals = {g: _rate(sum(o for o, _ in v), sum(n for _, n in v)) for g, v in groups.items()}
+    return {
+        "scenarios": rows,
+        "totals": totals,
+        "causes": causes,
+        "peak_torque_ratio_by_group": {k: round(v, 3) for k, v in peaks.items()},
+        "make_cpu_s_per_motion_s": _quantiles(make_ratio),
+        "simulate_cpu_s_per_motion_s": _quantiles(sim_ratio),
+    }
+
+
+def _quantiles(values: list) -> dict | None:
+    if not values:
+        return None
+    v = np.asarray(values)
+    return {"median": round(float(np.median(v)), 3), "max": round(float(v.max()), 3), "n": len(v)}
+
+
+def _pct(rate: dict) -> str:
+    if not rate["n"]:
+        return "-"
+    low, high = rate["wilson95"]
+    return f"{rate['ok']}/{rate['n']} ({100 * rate['rate']:.0f} %, {100 * low:.0f}-{100 * high:.0f} %)"
+
+
+def markdown(report: dict) -> str:
+    s = report["summary"]
+    lines = [
+        f"# Motion execution: variant `{report['variant']}`",
+        "",
+        f"MotionConfig overrides: `{json.dumps(report['motion_config'])}`; SimulationConfig overrides: "
+        f"`{json.dumps(report['simulation_config'])}`. RBLin plans: {report['starts']} start(s) per scenario, {report['ground_starts_per_cell']} per cell of ground's nine.",
+        "",
+        "| scenario | starts | verified plans | executed (95 % Wilson) | made, no fall | failures by cause |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, row in s["scenarios"].items():
+        sc = report["scenarios"][name]
+        causes = ", ".join(f"{k}: {v}" for k, v in sorted(row["causes"].items())) or "-"
+        lines.append(
+            f"| {name} | {sc['starts']} | {sc['verified_plans']} | {_pct(row['executed'])} "
+            f"| {_pct(row['made_and_upright'])} | {causes} |"
+        )
+    lines += [
+        f"| **target group** | | | {_pct(s['totals']['target'])} | | |",
+        f"| **all scenes** | | | {_pct(s['totals']['all'])} | | |",
+        "",
+        "Peak commanded torque / effort limit over every simulated motion, per joint group: "
+        + ", ".join(f"{k} {v:.2f}" for k, v in s["peak_torque_ratio_by_group"].items()),
+        "",
+    ]
+    for key, label in (
+        ("make_cpu_s_per_motion_s", "motion generation"),
+        ("simulate_cpu_s_per_motion_s", "simulation"),
+    ):
+        q = s[key]
+        if q:
+            lines.append(
+                f"- {label}: CPU s per s of motion, median {q['median']:.3f}, max {q['max']:.3f} over {q['n']} motions"
+                + (
+                    f" (real-time factor {1 / q['median']:.1f}x median, {1 / q['max']:.1f}x worst)"
+                    if key.startswith("sim")
+                    else ""
+                )
+            )
+    lines.append("")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", default=str(ROOT / "benchmarks/results/motion"))
+    parser.add_argument("--starts", type=int, default=4, help="starts of a one-cell scenario")
+    parser.add_argument("--ground-starts", type=int, default=1, help="starts per cell of ground (9 cells)")
+    parser.add_argument("--plans", default=str(ROOT / "runs/motion_plans"), help="plan cache folder")
+    parser.add_argument(
+        "--all", action="store_true", help="also the other evaluation scenarios and HPP scenes"
+    )
+    parser.add_argument(
+        "--scenarios", default=None, help="comma-separated scenario names (instead of the groups)"
+    )
+    parser.add_argument(
+        "--max-plans", type=int, default=0, help="execute at most this many plans per scenario"
+    )
+    parser.add_argument("--variant", default="current", help="name of this configuration in the output files")
+    parser.add_argument("--motion-config", default="{}", help="JSON of MotionConfig overrides")
+    parser.add_argument("--simulation-config", default="{}", help="JSON of SimulationConfig overrides")
+    args = parser.parse_args(argv)
+    report = run(args)
+    print(markdown(report))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -8,6 +8,7 @@ import json
 import re
 import shutil
 import subprocess
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -137,28 +138,56 @@ def test_write_html_is_self_contained_with_consistent_data(plan, tmp_path):
     assert np.allclose(_decode(data["guide"], "<f4").reshape(-1, 3), plan.guide[:, :3], atol=1e-6)
     assert _decode(data["footprints"]["left"], "<f4").size == 3 * 4 * 3
     assert _decode(data["footprints"]["right"], "<f4").size == 2 * 4 * 3
-    # Robot: 4 postures spread over 7, first and last kept.
+    # Robot: 4 postures spread over 7, first and last kept, as configurations.
     robot = data["robot"]
     assert robot["postures"] == [0, 2, 4, 6] and robot["guide_index"] == [0, 4, 8, 12]
-    n_geoms = len(robot["geoms"])
-    matrices = _decode(robot["matrices"], "<f4").reshape(4, n_geoms, 3, 4)
+    assert robot["overlay"] and [t["name"] for t in robot["tracks"]] == ["robot"]
+    q = _decode(robot["tracks"][0]["q"], "<f4").reshape(4, 39)
+    assert np.allclose(q, plan.q[[0, 2, 4, 6]], atol=1e-6)
+    assert np.allclose(_decode(robot["times"], "<f4"), np.arange(4) * viewer.PLAN_FRAME_PERIOD)
+    model = robot["model"]
+    assert model["kind"][:2] == ["universe", "free"] and set(model["kind"][2:]) == {"rx", "ry", "rz"}
+    assert all(model["parent"][j] < j for j in range(1, 34)) and model["nq"] == 39
+    assert len(model["geom_joint"]) == len(robot["geoms"]) == _decode(model["geom_placements"], "<f4").size // 12
     for mesh in data["meshes"]:
         vertices = _decode(mesh["positions"], "<f4").reshape(-1, 3)
         indices = _decode(mesh["indices"], "<u2" if mesh["index_type"] == "u16" else "<u4")
         assert indices.size % 3 == 0 and indices.max() < len(vertices)
     assert all(0 <= g["mesh"] < len(data["meshes"]) for g in robot["geoms"])
-    # The left ankle-roll mesh sits above the left sole (sole frame 0.107 m below
-    # the ankle): its placement at posture 2 (plan index 4) is ~0.1 m above feet[4, 0].
-    model, visual_model, *_ = viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)
-    drawn = [
-        g
-        for g, geom in enumerate(visual_model.geometryObjects)
-        if viewer._talos_visuals(viewer.DEFAULT_MESH_CELL)[3][g] >= 0
-    ]
-    slot = drawn.index(visual_model.getGeometryId("leg_left_6_link_0"))
-    ankle = matrices[2, slot, :, 3]
-    assert np.linalg.norm(ankle[:2] - plan.feet[4, 0, :2]) < 0.05
-    assert 0.08 < ankle[2] - plan.feet[4, 0, 2] < 0.13
+    # Terrain colours span the heights of its upward faces: the ground top (0) to the step top (0.1).
+    assert data["terrain"]["heights"] == pytest.approx([0.0, 0.1], abs=1e-6)
+
+
+def test_the_renderer_is_the_packaged_viewer_js_inlined(plan, tmp_path):
+    import tomllib
+    from importlib import resources
+    from pathlib import Path
+
+    script = resources.files("leas_jax.contacts").joinpath("viewer.js").read_text(encoding="utf-8")
+    assert viewer.viewer_script() == script and len(script) > 5000
+    viewer.write_html(plan, tmp_path / "view.html", robot=False)
+    _, code = _page_parts((tmp_path / "view.html").read_text())
+    assert code == script  # verbatim: nothing of the file lost, nothing else in the element
+    # A wheel (non-editable install) holds only the package data pyproject.toml names.
+    pyproject = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    assert "viewer.js" in pyproject["tool"]["setuptools"]["package-data"]["leas_jax.contacts"]
+
+
+def test_a_placeholder_in_the_data_is_not_substituted(plan, tmp_path):
+    named = ContactPlan(
+        q=plan.q,
+        feet=plan.feet,
+        guide_index=plan.guide_index,
+        last_valid_index=plan.last_valid_index,
+        coverage=plan.coverage,
+        terrain=TERRAIN.replace('name = "viewer_test"', 'name = "__SCRIPT__ __DATA__"'),
+        guide=plan.guide,
+    )
+    viewer.write_html(named, tmp_path / "view.html", robot=False)
+    text = (tmp_path / "view.html").read_text()
+    data, code = _page_parts(text)
+    assert data["name"] == "__SCRIPT__ __DATA__" and code == viewer.viewer_script()
+    assert text.count("__SCRIPT__") == 2  # the title and the data, nothing substituted into them
 
 
 def test_write_html_without_robot_is_small(plan, tmp_path):
@@ -203,7 +232,17 @@ global.document = {getElementById: element, body: element("body"),
   createElement: tag => node({tag}), createTextNode: text => node({tag: "#text", textContent: text}),
   write() { htmlWrites.push(["document", "write"]); }};
 global.window = {addEventListener() {}, devicePixelRatio: 1};
+global.location = {hash: typeof PAGE_HASH === "string" ? PAGE_HASH : ""};
 global.atob = s => Buffer.from(s, "base64").toString("binary");
+// animation frames run only when the script calls step(ms): a test drives the clock
+let clockNow = 0, frameCallbacks = [];
+global.performance = {now: () => clockNow};
+global.requestAnimationFrame = cb => { frameCallbacks.push(cb); return frameCallbacks.length; };
+function step(ms) {
+  clockNow += ms;
+  const due = frameCallbacks; frameCallbacks = [];
+  due.forEach(cb => cb(clockNow));
+}
 function drawsOf(from) {
   const out = {};
   for (const [name, args] of calls.slice(from)) if (name.startsWith("draw")) {
@@ -247,6 +286,136 @@ console.log(JSON.stringify({first, all, rendered: element("body").dataset.render
     assert out["all"]["drawElements:TRIANGLES"] == 1 + 4 * n_geoms
     assert out["rendered"] == "2" and out["max"] == 3
     assert out["label"] == "#0 (guide index 0)"
+
+
+def _run_page_under_node(data: dict, tail: str, tmp_path, page_hash: str = "") -> dict:
+    """Run the page's script on `data` in the Node harness, then `tail`; the last stdout line as JSON."""
+    script = (
+        f"const PLAN_JSON = {json.dumps(json.dumps(data))};\nconst PAGE_HASH = {json.dumps(page_hash)};\n"
+        + _HARNESS
+        + viewer.viewer_script()
+        + tail
+    )
+    (tmp_path / "run.js").write_text(script)
+    done = subprocess.run(["node", str(tmp_path / "run.js")], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="Node.js not installed")
+def test_page_kinematics_match_pinocchio(plan, tmp_path):
+    """The page's forward kinematics (JavaScript, float32) place every mesh where Pinocchio does."""
+    import example_robot_data
+    import pinocchio as pin
+
+    model = example_robot_data.load("talos").model
+    rng = np.random.default_rng(3)
+    qs = [plan.q[3]]
+    for _ in range(3):
+        q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+        q[:3] = rng.uniform(-3, 3, 3)
+        qs.append(q)
+    qs = np.array(qs)
+    expected, _ = viewer.robot_placements(qs)
+    data = viewer.html_payload(plan, max_postures=2)
+    out = _run_page_under_node(
+        data,
+        f"const QS = {json.dumps(qs.tolist())};\n"
+        + r"""
+const got = QS.map(q => window.leasViewer.geomPlacements(Float32Array.from(q), 0).map(m => Array.from(m)));
+console.log(JSON.stringify(got));
+""",
+        tmp_path,
+    )
+    got = np.array(out)  # [N, G, 16] column-major 4x4
+    assert got.shape == (len(qs), expected.shape[1], 16)
+    top = got.reshape(len(qs), -1, 4, 4).transpose(0, 1, 3, 2)[:, :, :3, :]  # rows of [R | p]
+    assert np.abs(top - expected).max() < 2e-4
+    assert np.allclose(got[..., [3, 7, 11]], 0) and np.allclose(got[..., 15], 1)
+
+
+def _rollout_view(tmp_path, fall_at=None):
+    """A planned motion (100 Hz, 3 s of Talos at half-sitting moving 0.3 m along x) and its
+    simulated rollout, which ends at `fall_at` samples; the page write_rollout_html makes of them."""
+    import example_robot_data
+
+    from leas_jax.motion.commands import write_rollout_html
+
+    base = example_robot_data.load("talos").model.referenceConfigurations["half_sitting"]
+    n = 301
+    q = np.tile(base, (n, 1))
+    q[:, 0] = np.linspace(0.0, 0.3, n)
+    simulated = q[: fall_at or n].copy()
+    simulated[:, 1] += 0.01  # off the plan by 1 cm
+    motion = SimpleNamespace(q=q, dt=0.01, duration=3.0, terrain=TERRAIN, plan_feet=np.full((1, 2, 7), np.nan))
+    rollout = SimpleNamespace(
+        q=simulated,
+        success=fall_at is None,
+        fallen=fall_at is not None,
+        summary=lambda: {"phases_reached": 2 if fall_at else 3, "phases": 3},
+    )
+    path = tmp_path / "rollout.html"
+    write_rollout_html(motion, rollout, path)
+    return path, q, simulated
+
+
+def test_rollout_page_holds_the_plan_and_the_simulation_at_25_hz(tmp_path):
+    path, q, simulated = _rollout_view(tmp_path, fall_at=150)
+    data, code = _page_parts(path.read_text())
+    robot = data["robot"]
+    assert [t["name"] for t in robot["tracks"]] == ["planned (ghost)", "simulated"]
+    assert [t["style"] for t in robot["tracks"]] == ["ghost", "solid"]
+    times = _decode(robot["times"], "<f4")
+    assert np.allclose(times, np.arange(0, 301, 4) * 0.01, atol=1e-6)  # 25 frames/s, 0 to 3 s
+    planned = _decode(robot["tracks"][0]["q"], "<f4").reshape(-1, 39)
+    assert np.allclose(planned, q[::4], atol=1e-6)
+    # The simulation ends at sample 149 (fell): its frames stop there, the last sample kept.
+    sim = _decode(robot["tracks"][1]["q"], "<f4").reshape(-1, 39)
+    assert np.allclose(sim, simulated[list(range(0, 150, 4)) + [149]], atol=1e-6)
+    assert "postures" not in robot and not robot["overlay"]
+    assert "fell" in data["subtitle"] and "2/3 phases" in data["subtitle"]
+    assert np.allclose(_decode(data["guide"], "<f4").reshape(-1, 3), simulated[:, :3], atol=1e-6)
+    # Size: meshes (~0.5 MB) and 0.2 kB per frame and track.
+    assert path.stat().st_size < 900_000
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="Node.js not installed")
+def test_rollout_page_plays_both_robots_in_time(tmp_path):
+    path, _, _ = _rollout_view(tmp_path, fall_at=150)
+    data, _ = _page_parts(path.read_text())
+    n_geoms = len(data["robot"]["geoms"])
+    out = _run_page_under_node(
+        data,
+        r"""
+const first = drawsOf(0), label0 = element("posture-label").textContent;
+element("speed").value = "2";
+element("play").onclick();
+step(0);
+step(500);  // 0.5 s at 2x: 1 s of motion, frame 25
+const f1 = element("posture").value, label1 = element("posture-label").textContent;
+step(2500);  // past the end (3 s): loops to the start
+const f2 = element("posture").value;
+element("play").onclick();  // pause
+const text = element("play").textContent;
+step(1000);
+const f3 = element("posture").value;
+// the simulated robot holds its last posture (sample 149) at t = 2 s
+element("posture").value = "50"; element("posture").oninput();
+const held = window.leasViewer.trackPlacements(DATA.robot.tracks[1], 50)[0][12];
+const last = window.leasViewer.trackPlacements(DATA.robot.tracks[1], 38)[0][12];
+const ghost = window.leasViewer.trackPlacements(DATA.robot.tracks[0], 50)[0][12];
+console.log(JSON.stringify({first, label0, f1, label1, f2, text, f3, held, last, ghost,
+  tracks: element("tracks").children.length}));
+""",
+        tmp_path,
+    )
+    # Two robots in the first frame: the terrain, then both tracks' geometries.
+    assert out["first"]["drawElements:TRIANGLES"] == 1 + 2 * n_geoms
+    assert out["label0"] == "t = 0.00 s / 3.00 s"
+    assert out["f1"] == "25" and out["label1"] == "t = 1.00 s / 3.00 s"
+    assert int(out["f2"]) < 10 and out["text"] == "play" and out["f3"] == out["f2"]
+    assert out["held"] == out["last"] and out["ghost"] > out["held"]  # the ghost walks on
+    assert out["tracks"] == 2  # a checkbox per track
 
 
 HOSTILE_NAME = '<img src=x onerror="require(`fs`).writeFileSync(`pwned`, `x`)"></script><!--'

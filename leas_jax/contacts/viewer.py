@@ -1,10 +1,13 @@
 """Views of a contact plan: a self-contained 3D HTML page and a top-down PNG (host-only).
 
 `write_html(plan, path)` writes one HTML file that needs no network: the data
-(terrain boxes, guide, footprints, decimated Talos meshes and their placements
-at the shown key postures) is inlined as base64 typed arrays, and a small
-WebGL2 renderer written here draws it (drag: orbit, right-drag or shift-drag:
-pan, wheel: zoom, slider: posture).
+(terrain mesh, guide, footprints, decimated Talos meshes, its kinematic tree and
+the configurations of the shown key postures) is inlined as base64 typed
+arrays, and a small WebGL2 renderer, the package's `viewer.js`, inlined too,
+draws it (drag: orbit, right-drag or shift-drag: pan, wheel: zoom, slider,
+play and speed: postures). `write_motion_html` writes the same page for
+motions: time series of configurations played together (e.g. a planned motion
+as a translucent ghost and its simulated rollout).
 
 `write_footsteps_png(plan, path)` draws the terrain heightmap from above with
 the guide, the footprints coloured by foot and the failed guide tail in red.
@@ -22,6 +25,9 @@ import functools
 import html
 import io
 import json
+import re
+from importlib import resources
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -40,6 +46,11 @@ DEFAULT_MESH_CELL = 0.012  # m
 # Postures whose robot placements are stored in the HTML: the slider and the
 # "all" overlay use these; beyond ~60 the overlay is unreadable anyway.
 DEFAULT_MAX_POSTURES = 60
+# Playing a plan's page shows one stored posture every PLAN_FRAME_PERIOD seconds (at 1x).
+PLAN_FRAME_PERIOD = 0.4  # s
+# Frames per second stored in a motion's page (`write_motion_html`): smooth playback,
+# 0.16 kB per frame and track of configurations.
+DEFAULT_FRAME_RATE = 25.0  # Hz
 
 
 def _terrain_of(plan):
@@ -287,36 +298,128 @@ def _b64(array: np.ndarray, dtype) -> str:
     return base64.b64encode(np.ascontiguousarray(array, dtype=dtype).tobytes()).decode("ascii")
 
 
-def html_payload(
-    plan,
-    *,
-    max_postures: int = DEFAULT_MAX_POSTURES,
-    mesh_cell: float = DEFAULT_MESH_CELL,
-    robot: bool = True,
-) -> dict:
-    """The data inlined in the HTML page, as a JSON-ready dict (typed arrays in base64, little-endian).
+def robot_model_payload(cell: float = DEFAULT_MESH_CELL) -> dict:
+    """Talos's kinematic tree and drawn geometries for the page's forward kinematics.
 
-    Keys: name, coverage, last_valid_index, bounds, terrain {positions f32
-    [V*3], indices u32}, guide f32 [T*3], footprints {left, right: f32 [n*4*3]
-    corners}, meshes [{positions f32, indices u16|u32, index_type}],
-    robot {geoms [{mesh, color}], postures [P] (plan indices), guide_index
-    [P], matrices f32 [P*G*12] row-major 3x4}.
+    The page places the meshes itself from configurations q (39 floats a frame
+    instead of 12 per geometry): joint j's world placement is
+    parent's placement * joint placement * joint motion (the free flyer's
+    translation and quaternion xyzw, or a rotation about x, y or z by q[q_index]),
+    and geometry g's is its joint's placement * its own (mesh scale folded in).
+
+    Returns:
+        dict: parent [J] (joint 0 is the universe), kind [J] ("universe",
+        "free", "rx", "ry", "rz"), q_index [J], nq, joint_placements f32
+        [J*12] (row-major 3x4, base64), geom_joint [G], geom_placements f32
+        [G*12]; G counts the drawn geometries (those of `robot_placements`).
+    """
+    model, visual_model, _, geom_mesh, geom_scale, _ = _talos_visuals(cell)
+    kinds = []
+    for j, joint in enumerate(model.joints):
+        name = joint.shortname()
+        if j == 0:
+            kinds.append("universe")
+        elif name == "JointModelFreeFlyer":
+            kinds.append("free")
+        elif name in ("JointModelRX", "JointModelRY", "JointModelRZ"):
+            kinds.append("r" + name[-1].lower())
+        else:  # the page knows only these; Talos has no other kind
+            raise ValueError(f"joint {model.names[j]}: {name} is not drawn by the viewer")
+    joints = np.zeros((model.njoints, 3, 4))
+    for j in range(model.njoints):
+        placement = model.jointPlacements[j]
+        joints[j] = np.c_[placement.rotation, placement.translation]
+    drawn = [g for g, m in enumerate(geom_mesh) if m >= 0]
+    geoms = np.zeros((len(drawn), 3, 4))
+    for slot, g in enumerate(drawn):
+        placement = visual_model.geometryObjects[g].placement
+        geoms[slot] = np.c_[placement.rotation * geom_scale[g][None, :], placement.translation]
+    return {
+        "parent": [int(p) for p in model.parents],
+        "kind": kinds,
+        "q_index": [int(i) for i in model.idx_qs],
+        "nq": int(model.nq),
+        "joint_placements": _b64(joints, "<f4"),
+        "geom_joint": [int(visual_model.geometryObjects[g].parentJoint) for g in drawn],
+        "geom_placements": _b64(geoms, "<f4"),
+    }
+
+
+def _robot_payload(tracks, times, mesh_cell: float) -> tuple[list, dict]:
+    """Meshes and the robot entry of a page: model, geometries and the tracks' configurations.
+
+    Args:
+        tracks: list of (name, q [F_k, 39], color): color None draws the robot in
+            its own colours, an RGBA tuple draws it translucent in that colour.
+        times: [F] s, the frames' times (F the longest track; shorter tracks
+            hold their last configuration).
+    """
+    _, _, meshes, geom_mesh, _, geom_color = _talos_visuals(mesh_cell)
+    drawn = [g for g, m in enumerate(geom_mesh) if m >= 0]
+    mesh_entries = []
+    for vertices, faces in meshes:
+        small = vertices.shape[0] < 65536  # 16-bit indices halve the largest arrays
+        mesh_entries.append(
+            {
+                "positions": _b64(vertices, "<f4"),
+                "indices": _b64(faces, "<u2" if small else "<u4"),
+                "index_type": "u16" if small else "u32",
+            }
+        )
+    entry = {
+        "model": robot_model_payload(mesh_cell),
+        "geoms": [{"mesh": int(geom_mesh[g]), "color": [float(c) for c in geom_color[g]]} for g in drawn],
+        "tracks": [
+            {
+                "name": name,
+                "style": "solid" if color is None else "ghost",
+                "color": None if color is None else [float(c) for c in color],
+                "q": _b64(np.asarray(q, dtype=np.float64), "<f4"),
+            }
+            for name, q, color in tracks
+        ],
+        "times": _b64(np.asarray(times, dtype=np.float64), "<f4"),
+        "overlay": False,
+    }
+    return mesh_entries, entry
+
+
+def _scene_payload(terrain, name: str, subtitle: str, guide, last_valid_index: int, feet) -> dict:
+    """The page's data without a robot: terrain mesh, guide, footprints.
+
+    `terrain.heights` is the range of the heights of the terrain's upward faces
+    (normal z > 0.5; either way up for a mesh wound inwards): the page colours
+    the terrain by height over it.
     """
     from leas_jax.terrain.export import terrain_to_mesh
 
-    terrain = _terrain_of(plan)
     mesh = terrain_to_mesh(terrain)
-    guide = np.asarray(plan.guide, dtype=np.float64)
+    vertices, faces = np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces)
+    heights = [0.0, 1.0]
+    if len(faces):
+        triangles = vertices[faces]
+        normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+        length = np.linalg.norm(normals, axis=1)
+        cosine = np.divide(normals[:, 2], length, out=np.zeros(len(faces)), where=length > 0)
+        up = cosine > 0.5
+        if not up.any():  # a mesh wound inwards: its tops face down
+            up = np.abs(cosine) > 0.5
+        z = triangles[up][..., 2] if up.any() else triangles[..., 2]
+        heights = [float(z.min()), float(max(z.max(), z.min() + 0.05))]
     feet_by_foot = {0: [], 1: []}
-    for foot, _, corners in footprints(plan):
+    for foot, _, corners in footprints(SimpleNamespace(feet=feet)):
         feet_by_foot[foot].append(corners)
-    payload = {
-        "name": terrain.name,
-        "coverage": float(plan.coverage),
-        "last_valid_index": int(plan.last_valid_index),
-        "n_postures": int(np.asarray(plan.q).shape[0]),
+    guide = np.asarray(guide, dtype=np.float64)
+    return {
+        "name": name,
+        "subtitle": subtitle,
+        "last_valid_index": int(last_valid_index),
         "bounds": np.asarray(terrain.bounds, dtype=float).tolist(),
-        "terrain": {"positions": _b64(mesh.vertices, "<f4"), "indices": _b64(mesh.faces, "<u4")},
+        "terrain": {
+            "positions": _b64(vertices, "<f4"),
+            "indices": _b64(faces, "<u4"),
+            "heights": heights,
+        },
         "guide": _b64(guide[:, :3], "<f4"),
         "footprints": {
             FOOT_NAMES[f]: _b64(np.reshape(c, (-1, 3)) if c else np.zeros((0, 3)), "<f4")
@@ -326,27 +429,117 @@ def html_payload(
         "meshes": [],
         "robot": None,
     }
+
+
+def html_payload(
+    plan,
+    *,
+    max_postures: int = DEFAULT_MAX_POSTURES,
+    mesh_cell: float = DEFAULT_MESH_CELL,
+    robot: bool = True,
+) -> dict:
+    """The data inlined in a plan's page, as a JSON-ready dict (typed arrays in base64, little-endian).
+
+    Keys: name, subtitle (coverage, last valid index, postures), coverage,
+    last_valid_index, n_postures, bounds, terrain {positions f32 [V*3],
+    indices u32, heights [2]}, guide f32 [T*3], footprints {left, right: f32
+    [n*4*3] corners}, foot_colors, meshes [{positions f32, indices u16|u32,
+    index_type}], robot (None without one) {model (`robot_model_payload`),
+    geoms [{mesh, color}], tracks [{name, style, color, q f32 [P*39]}],
+    times f32 [P] (s: one stored posture every `PLAN_FRAME_PERIOD` when
+    played), overlay (all postures can be drawn at once), postures [P] (plan
+    indices), guide_index [P]}.
+    """
+    terrain = _terrain_of(plan)
     q = np.asarray(plan.q, dtype=np.float64)
+    chosen = _select_postures(q.shape[0], max_postures)
+    subtitle = (
+        f"coverage {float(plan.coverage):.3f}, last valid index {int(plan.last_valid_index)}, "
+        f"{q.shape[0]} postures" + (f" ({len(chosen)} stored)" if robot and q.shape[0] else "")
+    )
+    payload = _scene_payload(terrain, terrain.name, subtitle, plan.guide, plan.last_valid_index, plan.feet)
+    payload.update(coverage=float(plan.coverage), n_postures=int(q.shape[0]))
     if robot and q.shape[0] > 0:
-        _, _, meshes, geom_mesh, _, geom_color = _talos_visuals(mesh_cell)
-        chosen = _select_postures(q.shape[0], max_postures)
-        matrices, drawn = robot_placements(q[chosen], mesh_cell)
-        for vertices, faces in meshes:
-            small = vertices.shape[0] < 65536  # 16-bit indices halve the largest arrays
-            payload["meshes"].append(
-                {
-                    "positions": _b64(vertices, "<f4"),
-                    "indices": _b64(faces, "<u2" if small else "<u4"),
-                    "index_type": "u16" if small else "u32",
-                }
-            )
-        payload["robot"] = {
-            "geoms": [{"mesh": int(geom_mesh[g]), "color": [float(c) for c in geom_color[g]]} for g in drawn],
-            "postures": chosen.tolist(),
-            "guide_index": np.asarray(plan.guide_index)[chosen].astype(int).tolist(),
-            "matrices": _b64(matrices, "<f4"),
-        }
+        meshes, entry = _robot_payload(
+            [("robot", q[chosen], None)], np.arange(len(chosen)) * PLAN_FRAME_PERIOD, mesh_cell
+        )
+        entry.update(
+            overlay=True,
+            postures=chosen.tolist(),
+            guide_index=np.asarray(plan.guide_index)[chosen].astype(int).tolist(),
+        )
+        payload.update(meshes=meshes, robot=entry)
     return payload
+
+
+def motion_payload(
+    terrain,
+    feet,
+    tracks,
+    dt: float,
+    *,
+    rate: float = DEFAULT_FRAME_RATE,
+    line=None,
+    subtitle: str = "",
+    mesh_cell: float = DEFAULT_MESH_CELL,
+) -> dict:
+    """The data of a page that animates motions (time series of configurations) over a terrain.
+
+    Args:
+        terrain: file text or `Terrain`.
+        feet: [K, 2, 7] sole placements whose footprints are drawn (`footprints`).
+        tracks: list of (name, q [N_k, 39] sampled every `dt`, color): color None
+            draws the robot in its own colours, an RGBA tuple translucent in
+            that colour (a ghost). All start at time 0; the shorter ones hold
+            their last configuration.
+        dt: sampling period of the tracks, s.
+        rate: frames stored per second (the tracks are subsampled to it; the
+            last sample of each is kept).
+        line: [T, >=3] points drawn as the green line (e.g. the root's path), or None.
+        subtitle: text after the terrain name.
+
+    Returns:
+        the `html_payload` keys; robot.times are the frames' times (s), no
+        postures or guide_index, overlay False.
+    """
+    terrain = _terrain_of(SimpleNamespace(terrain=terrain))
+    stride = max(1, int(round(1.0 / (rate * dt))))
+    longest = max(len(q) for _, q, _ in tracks)
+    frames = np.arange(0, longest, stride)
+    if frames[-1] != longest - 1:
+        frames = np.append(frames, longest - 1)
+    sampled = []
+    for name, q, color in tracks:
+        q = np.asarray(q, dtype=np.float64)
+        own = frames[frames < len(q)]
+        if own[-1] != len(q) - 1:  # a track that ends between frames shows its end next
+            own = np.append(own, len(q) - 1)
+        sampled.append((name, q[own], color))
+    line = np.zeros((0, 3)) if line is None else np.asarray(line, dtype=np.float64)
+    payload = _scene_payload(terrain, terrain.name, subtitle, line, len(line) - 1, feet)
+    payload["meshes"], payload["robot"] = _robot_payload(sampled, frames * dt, mesh_cell)
+    return payload
+
+
+def _page(payload: dict, title: str) -> str:
+    """The HTML page: template, escaped title, the payload's JSON and the inlined renderer."""
+    parts = {"TITLE": html.escape(title), "DATA": script_json(payload), "SCRIPT": viewer_script()}
+    # one pass: a placeholder's name inside the data or the script is left as it is
+    return re.sub(r"__(TITLE|DATA|SCRIPT)__", lambda match: parts[match.group(1)], _PAGE)
+
+
+@functools.lru_cache(maxsize=1)
+def viewer_script() -> str:
+    """The renderer's JavaScript (the package's viewer.js), checked to be safe to inline.
+
+    Raises:
+        ValueError: the file holds "</script" or "<!--", which would end or break
+            the page's <script> element.
+    """
+    text = resources.files("leas_jax.contacts").joinpath("viewer.js").read_text(encoding="utf-8")
+    if re.search(r"</script|<!--", text, re.IGNORECASE):
+        raise ValueError("viewer.js holds </script or <!--: it cannot be inlined")
+    return text
 
 
 def write_html(
@@ -359,11 +552,12 @@ def write_html(
 ) -> None:
     """Write a self-contained 3D view of the plan (no network, no CDN).
 
-    Shows the terrain boxes, the guide (green up to `last_valid_index`, red
-    after), the footprints (sole rectangles, blue left / orange right) and the
-    Talos meshes at up to `max_postures` key postures (slider, or all at once).
-    A few MB at most: the meshes are decimated and stored once, each posture
-    adds only 3x4 matrices. Host-only (Pinocchio, trimesh).
+    Shows the terrain (coloured by height), the guide (green up to
+    `last_valid_index`, red after), the footprints (sole rectangles, blue left
+    / orange right) and Talos at up to `max_postures` key postures (slider,
+    play, or all at once). A few MB at most: the meshes are decimated and
+    stored once, each posture adds only its configuration (39 floats).
+    Host-only (Pinocchio, trimesh).
 
     Args:
         plan: a ContactPlan (docs/design.md §6 attributes).
@@ -375,9 +569,22 @@ def write_html(
     from leas_jax.files import atomic_write_text
 
     payload = html_payload(plan, max_postures=max_postures, mesh_cell=mesh_cell, robot=robot)
-    title = html.escape(f"LeaS contact plan: {payload['name']}")
-    page = _PAGE.replace("__TITLE__", title).replace("__DATA__", script_json(payload))
-    atomic_write_text(path, page)
+    atomic_write_text(path, _page(payload, f"LeaS contact plan: {payload['name']}"))
+
+
+def write_motion_html(
+    path, terrain, feet, tracks, dt: float, *, title: str = "LeaS motion", **options
+) -> None:
+    """Write a self-contained page that animates motions over a terrain (play, pause, time slider, speed).
+
+    Arguments as `motion_payload` (`options`: rate, line, subtitle, mesh_cell);
+    `title` is the page's title. About 0.3 kB per stored frame and track (25
+    frames/s by default) over the ~0.5 MB of meshes.
+    """
+    from leas_jax.files import atomic_write_text
+
+    payload = motion_payload(terrain, feet, tracks, dt, **options)
+    atomic_write_text(path, _page(payload, f"{title}: {payload['name']}"))
 
 
 # Characters of JSON text escaped inside the page's <script>: with no "<", ">" or "&" left, no
@@ -394,6 +601,7 @@ def script_json(payload) -> str:
     return text
 
 
+# The page: panel and canvas; the data (__DATA__) and the renderer (__SCRIPT__, viewer.js) are inlined.
 _PAGE = r"""<!DOCTYPE html>
 <html lang="en">
 <head>
@@ -403,7 +611,7 @@ _PAGE = r"""<!DOCTYPE html>
   html, body { margin: 0; height: 100%; overflow: hidden; background: #20242a; font: 13px sans-serif; color: #ddd; }
   #view { width: 100%; height: 100%; display: block; }
   #panel { position: absolute; top: 8px; left: 8px; background: rgba(20, 22, 26, 0.85); padding: 8px 10px;
-           border-radius: 4px; max-width: 420px; }
+           border-radius: 4px; max-width: 440px; }
   #panel input[type=range] { width: 260px; vertical-align: middle; }
   .left { color: rgb(31, 120, 181); } .right { color: rgb(255, 127, 14); }
   .ok { color: #4c4; } .bad { color: #e44; }
@@ -414,257 +622,22 @@ _PAGE = r"""<!DOCTYPE html>
 <div id="panel">
   <div id="info"></div>
   <div id="robot-controls">
-    posture <input id="posture" type="range" min="0" max="0" value="0"> <span id="posture-label"></span><br>
-    <label><input id="show-all" type="checkbox"> all stored postures</label>
-    <label><input id="show-robot" type="checkbox" checked> robot</label>
+    <input id="posture" type="range" min="0" max="0" value="0"> <span id="posture-label"></span><br>
     <button id="play">play</button>
+    speed <select id="speed"><option value="0.25">0.25x</option><option value="0.5">0.5x</option>
+      <option value="1" selected>1x</option><option value="2">2x</option><option value="4">4x</option></select>
+    <label><input id="show-robot" type="checkbox" checked> robot</label>
+    <label id="show-all-label"><input id="show-all" type="checkbox"> all stored postures</label>
+    <span id="tracks"></span>
   </div>
   <div>feet: <span class="left">&#9632; left</span> <span class="right">&#9632; right</span>;
-    guide: <span class="ok">covered</span> / <span class="bad">failed</span></div>
+    path: <span class="ok">covered</span> / <span class="bad">failed</span>; terrain coloured by height</div>
   <div style="color:#999">drag: orbit &middot; right/shift-drag: pan &middot; wheel: zoom</div>
   <div id="error" class="bad"></div>
 </div>
 <script id="plan-data" type="application/json">__DATA__</script>
 <script>
-"use strict";
-const DATA = JSON.parse(document.getElementById("plan-data").textContent);
-
-function decode(b64, Type) {
-  const bin = atob(b64), bytes = new Uint8Array(bin.length);
-  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-  return new Type(bytes.buffer);
-}
-
-// ---- 4x4 column-major matrices (WebGL layout)
-function perspective(fovy, aspect, near, far) {
-  const f = 1 / Math.tan(fovy / 2), nf = 1 / (near - far);
-  return new Float32Array([f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1, 0, 0, 2 * far * near * nf, 0]);
-}
-function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
-function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
-function normalize(a) { const n = Math.hypot(a[0], a[1], a[2]) || 1; return [a[0] / n, a[1] / n, a[2] / n]; }
-function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-function lookAt(eye, target, up) {
-  const z = normalize(sub(eye, target)), x = normalize(cross(up, z)), y = cross(z, x);
-  return new Float32Array([x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0,
-                           -dot(x, eye), -dot(y, eye), -dot(z, eye), 1]);
-}
-// Row-major 3x4 [R | p] from Python to column-major 4x4.
-function fromRows34(m, o) {
-  return new Float32Array([m[o], m[o + 4], m[o + 8], 0, m[o + 1], m[o + 5], m[o + 9], 0,
-                           m[o + 2], m[o + 6], m[o + 10], 0, m[o + 3], m[o + 7], m[o + 11], 1]);
-}
-const IDENTITY = new Float32Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
-
-const canvas = document.getElementById("view");
-const gl = canvas.getContext("webgl2", {antialias: true});
-if (!gl) {
-  document.getElementById("error").textContent = "WebGL2 is not available in this browser.";
-  throw new Error("no WebGL2");
-}
-
-// Normals come from screen-space derivatives of the world position: meshes
-// need no normal arrays (smaller file) and are shaded flat per triangle.
-const VS = `#version 300 es
-in vec3 aPos;
-uniform mat4 uProj, uView, uModel;
-out vec3 vWorld;
-void main() {
-  vec4 w = uModel * vec4(aPos, 1.0);
-  vWorld = w.xyz;
-  gl_Position = uProj * uView * w;
-}`;
-const FS = `#version 300 es
-precision highp float;
-in vec3 vWorld;
-uniform vec4 uColor;
-uniform int uMode;  // 0: shaded, 1: flat colour (lines), 2: shaded terrain with a 0.5 m grid
-out vec4 outColor;
-void main() {
-  if (uMode == 1) { outColor = uColor; return; }
-  vec3 n = normalize(cross(dFdx(vWorld), dFdy(vWorld)));
-  float light = 0.35 + 0.5 * abs(dot(n, normalize(vec3(0.4, 0.3, 1.0)))) + 0.15 * abs(n.x);
-  vec3 c = uColor.rgb * light;
-  if (uMode == 2) {
-    vec2 g = abs(fract(vWorld.xy * 2.0 + 0.5) - 0.5) / fwidth(vWorld.xy * 2.0);
-    float line = 1.0 - min(min(g.x, g.y), 1.0);
-    c = mix(c, c * 0.6, line * abs(n.z));
-  }
-  outColor = vec4(c, uColor.a);
-}`;
-function compile(type, src) {
-  const s = gl.createShader(type);
-  gl.shaderSource(s, src);
-  gl.compileShader(s);
-  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
-  return s;
-}
-const prog = gl.createProgram();
-gl.attachShader(prog, compile(gl.VERTEX_SHADER, VS));
-gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, FS));
-gl.linkProgram(prog);
-if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
-gl.useProgram(prog);
-const loc = {};
-for (const name of ["uProj", "uView", "uModel", "uColor", "uMode"]) loc[name] = gl.getUniformLocation(prog, name);
-const aPos = gl.getAttribLocation(prog, "aPos");
-
-function makeDrawable(positions, indices, indexType) {
-  const vao = gl.createVertexArray();
-  gl.bindVertexArray(vao);
-  const vbo = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, vbo);
-  gl.bufferData(gl.ARRAY_BUFFER, positions, gl.STATIC_DRAW);
-  gl.enableVertexAttribArray(aPos);
-  gl.vertexAttribPointer(aPos, 3, gl.FLOAT, false, 0, 0);
-  let count = positions.length / 3, type = null;
-  if (indices) {
-    const ibo = gl.createBuffer();
-    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, ibo);
-    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
-    count = indices.length;
-    type = indexType === "u16" ? gl.UNSIGNED_SHORT : gl.UNSIGNED_INT;
-  }
-  gl.bindVertexArray(null);
-  return {vao, count, type};
-}
-function draw(d, mode, primitive, color, model) {
-  if (d.count === 0) return;
-  gl.uniformMatrix4fv(loc.uModel, false, model || IDENTITY);
-  gl.uniform4fv(loc.uColor, color);
-  gl.uniform1i(loc.uMode, mode);
-  gl.bindVertexArray(d.vao);
-  if (d.type !== null) gl.drawElements(primitive, d.count, d.type, 0);
-  else gl.drawArrays(primitive, 0, d.count);
-}
-
-// ---- scene
-const terrain = makeDrawable(decode(DATA.terrain.positions, Float32Array), decode(DATA.terrain.indices, Uint32Array), "u32");
-const guideAll = decode(DATA.guide, Float32Array);
-const nGuide = guideAll.length / 3, lastValid = DATA.last_valid_index;
-const okEnd = Math.max(0, Math.min(lastValid, nGuide - 1));
-const guideOk = makeDrawable(lastValid >= 0 ? guideAll.slice(0, 3 * (okEnd + 1)) : new Float32Array(0));
-const guideBad = makeDrawable(lastValid < nGuide - 1 ? guideAll.slice(lastValid >= 0 ? 3 * okEnd : 0) : new Float32Array(0));
-// Footprints: each rectangle (4 corners) as 2 triangles and a closed outline,
-// lifted 3 mm to stay above the support surface.
-function footDrawables(b64) {
-  const c = decode(b64, Float32Array), n = c.length / 12;
-  const tri = new Float32Array(n * 18), lines = new Float32Array(n * 24);
-  for (let r = 0; r < n; r++) {
-    const v = i => [c[12 * r + 3 * i], c[12 * r + 3 * i + 1], c[12 * r + 3 * i + 2] + 0.003];
-    [0, 1, 2, 0, 2, 3].forEach((i, k) => tri.set(v(i), 18 * r + 3 * k));
-    [0, 1, 1, 2, 2, 3, 3, 0].forEach((i, k) => lines.set(v(i), 24 * r + 3 * k));
-  }
-  return {fill: makeDrawable(tri), outline: makeDrawable(lines)};
-}
-const feet = [footDrawables(DATA.footprints.left), footDrawables(DATA.footprints.right)];
-const meshes = DATA.meshes.map(m => makeDrawable(decode(m.positions, Float32Array),
-    decode(m.indices, m.index_type === "u16" ? Uint16Array : Uint32Array), m.index_type));
-const robot = DATA.robot;
-let robotMatrices = [];
-if (robot) {
-  const flat = decode(robot.matrices, Float32Array), G = robot.geoms.length;
-  for (let p = 0; p < robot.postures.length; p++) {
-    const perPosture = [];
-    for (let g = 0; g < G; g++) perPosture.push(fromRows34(flat, 12 * (p * G + g)));
-    robotMatrices.push(perPosture);
-  }
-}
-
-// ---- UI
-const slider = document.getElementById("posture"), label = document.getElementById("posture-label");
-const showAll = document.getElementById("show-all"), showRobot = document.getElementById("show-robot");
-// data goes into the page as text nodes only (textContent), never parsed as HTML
-const info = document.getElementById("info"), nameNode = document.createElement("b");
-nameNode.textContent = String(DATA.name);
-info.appendChild(nameNode);
-info.appendChild(document.createTextNode(
-  `: coverage ${Number(DATA.coverage).toFixed(3)}, last valid index ${Number(DATA.last_valid_index)}, ` +
-  `${Number(DATA.n_postures)} postures` + (robot ? ` (${robot.postures.length} stored)` : "")));
-if (robot) slider.max = robot.postures.length - 1;
-else document.getElementById("robot-controls").style.display = "none";
-function updateLabel() {
-  if (!robot) return;
-  const p = +slider.value;
-  label.textContent = `#${robot.postures[p]} (guide index ${robot.guide_index[p]})`;
-}
-let playing = null;
-document.getElementById("play").onclick = () => {
-  if (playing) { clearInterval(playing); playing = null; return; }
-  playing = setInterval(() => { slider.value = (+slider.value + 1) % (+slider.max + 1); updateLabel(); render(); }, 300);
-};
-slider.oninput = () => { updateLabel(); render(); };
-showAll.onchange = showRobot.onchange = render;
-updateLabel();
-
-// ---- orbit camera (z up) around the centre of the terrain bounds
-const b = DATA.bounds;
-const cam = {
-  target: [(b[0][0] + b[1][0]) / 2, (b[0][1] + b[1][1]) / 2, 0],
-  dist: 1.2 * Math.hypot(b[1][0] - b[0][0], b[1][1] - b[0][1]),
-  az: -Math.PI / 2 - 0.5, el: 0.6,
-};
-function eye() {
-  return [cam.target[0] + cam.dist * Math.cos(cam.el) * Math.cos(cam.az),
-          cam.target[1] + cam.dist * Math.cos(cam.el) * Math.sin(cam.az),
-          cam.target[2] + cam.dist * Math.sin(cam.el)];
-}
-let drag = null;
-canvas.addEventListener("contextmenu", e => e.preventDefault());
-canvas.addEventListener("mousedown", e => { drag = {x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey}; });
-window.addEventListener("mouseup", () => { drag = null; });
-window.addEventListener("mousemove", e => {
-  if (!drag) return;
-  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
-  drag.x = e.clientX; drag.y = e.clientY;
-  if (drag.pan) {
-    const s = cam.dist * 0.0015, ca = Math.cos(cam.az), sa = Math.sin(cam.az);
-    // Grab-the-ground panning: screen right is (-sin az, cos az), the view
-    // direction on the ground is -(cos az, sin az).
-    cam.target[0] += s * (dx * sa - dy * ca);
-    cam.target[1] += s * (-dx * ca - dy * sa);
-  } else {
-    cam.az -= dx * 0.005;
-    cam.el = Math.max(-1.5, Math.min(1.5, cam.el + dy * 0.005));
-  }
-  render();
-});
-canvas.addEventListener("wheel", e => {
-  e.preventDefault();
-  cam.dist = Math.max(0.2, cam.dist * Math.exp(e.deltaY * 0.001));
-  render();
-}, {passive: false});
-
-function render() {
-  const w = canvas.clientWidth, h = canvas.clientHeight, dpr = window.devicePixelRatio || 1;
-  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
-    canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
-  }
-  gl.viewport(0, 0, canvas.width, canvas.height);
-  gl.clearColor(0.13, 0.14, 0.16, 1);
-  gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-  gl.enable(gl.DEPTH_TEST);
-  gl.uniformMatrix4fv(loc.uProj, false, perspective(0.8, canvas.width / Math.max(1, canvas.height), 0.02, 500));
-  gl.uniformMatrix4fv(loc.uView, false, lookAt(eye(), cam.target, [0, 0, 1]));
-  draw(terrain, 2, gl.TRIANGLES, [0.62, 0.58, 0.50, 1]);
-  draw(guideOk, 1, gl.LINE_STRIP, [0.3, 0.85, 0.3, 1]);
-  draw(guideBad, 1, gl.LINE_STRIP, [0.95, 0.2, 0.2, 1]);
-  feet.forEach((f, i) => {
-    const c = DATA.foot_colors[i];
-    draw(f.fill, 0, gl.TRIANGLES, [c[0], c[1], c[2], 1]);
-    draw(f.outline, 1, gl.LINES, [0.05, 0.05, 0.05, 1]);
-  });
-  if (robot && showRobot.checked) {
-    const shown = showAll.checked ? robotMatrices.map((_, p) => p) : [+slider.value];
-    for (const p of shown) {
-      robot.geoms.forEach((g, i) => draw(meshes[g.mesh], 0, gl.TRIANGLES, [g.color[0], g.color[1], g.color[2], 1], robotMatrices[p][i]));
-    }
-  }
-  document.body.dataset.rendered = String((+document.body.dataset.rendered || 0) + 1);
-}
-window.addEventListener("resize", render);
-render();
-</script>
+__SCRIPT__</script>
 </body>
 </html>
 """

@@ -115,7 +115,26 @@ class RewardWeights:
     clearance: float = 0.0
 
 
-CLEARANCE_CONDITIONS = ("condition", "cylinders")  # values of EnvConfig.clearance_condition
+@dataclass(frozen=True)
+class CurriculumConfig:
+    """How envs move between the difficulty rows of a curriculum arena (a terrain with a
+    `[curriculum]` table; `leas_jax.terrain.curriculum`). legged_gym's `terrain_levels` rule:
+    at the end of an episode, an env that walked at least `level_up_distance` from its start
+    goes one row up, one that walked less than `level_down_distance` one row down; past the
+    top row it goes to a random row (so the hardest rows do not hold every env)."""
+
+    # m, half a 6 m tile (legged_gym promotes at half its tile's length)
+    level_up_distance: float = 3.0
+    # m: legged_gym demotes below half the distance its command asks for in an episode; the
+    # target direction here turns at random, so a fixed 1.5 m (a fifth of 400 steps at
+    # 0.18 m/s) marks an episode that failed early or stood still
+    level_down_distance: float = 1.5
+    initial_max_level: int = 2  # first episodes start on rows 0..this (legged_gym: 5 of 10)
+
+
+CLEARANCE_CONDITIONS = ("condition", "cylinders")
+# Values of EnvConfig.condition whose network the heightfield carries (weights: learned_weights)
+NETWORK_CONDITIONS = ("learned", "walkability")  # values of EnvConfig.clearance_condition
 
 
 @dataclass(frozen=True)
@@ -177,6 +196,7 @@ class EnvConfig:
     condition: str = "cylinders"
     learned_weights: str = "checkpoints/feasibility/walking.npz"
     reachability: ReachabilityConfig = field(default_factory=ReachabilityConfig)
+    curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)
     heightmap: HeightmapConfig = field(default_factory=HeightmapConfig)
     rewards: RewardWeights = field(default_factory=RewardWeights)
 

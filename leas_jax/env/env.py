@@ -33,6 +33,8 @@ class RootState:
         follow_point: bool[]; True: the target direction points at `target_point` each step.
         steps: int32[] steps taken in this episode.
         rng: [2] uint32 PRNG key for the next reset.
+        start: [2] world (x, y) where the episode started.
+        level: int32[] the env's curriculum row (0 on a field without a curriculum).
     """
 
     pos: jax.Array
@@ -43,6 +45,8 @@ class RootState:
     follow_point: jax.Array
     steps: jax.Array
     rng: jax.Array
+    start: jax.Array
+    level: jax.Array
 
     @property
     def pose(self) -> jax.Array:
@@ -135,11 +139,31 @@ class LeasEnv(Env):
         root = self.random_root(rng)
         return self._state(root, jnp.zeros(()), jnp.zeros(()), self._zero_metrics(), jnp.zeros(()))
 
-    def random_root(self, rng: jax.Array) -> RootState:
+    def next_root(self, root: RootState) -> RootState:
+        """The start of the episode after `root`'s (which has ended): `random_root` with its key,
+        on a curriculum arena on the row its walk earns (`EnvConfig.curriculum`)."""
+        if not self.field.curriculum:
+            return self.random_root(root.rng)
+        rule = self.config.curriculum
+        walked = jnp.linalg.norm(root.pos[:2] - root.start)
+        up = walked >= rule.level_up_distance
+        down = (walked < rule.level_down_distance) & ~up
+        level = root.level + up.astype(jnp.int32) - down.astype(jnp.int32)
+        levels = self.field.curriculum["level_count"].shape[0]
+        anywhere = jax.random.randint(jax.random.fold_in(root.rng, 1), (), 0, levels)
+        level = jnp.where(level >= levels, anywhere, jnp.maximum(level, 0))
+        return self.random_root(root.rng, level)
+
+    def random_root(self, rng: jax.Array, level=None) -> RootState:
         """Root state of a fresh random start (no observation; see `reset`).
 
         One uniform draw feeds every random quantity (each threefry call
         costs about as much as a reachability test on a CPU).
+
+        Args:
+            rng: PRNG key.
+            level: int32[] curriculum row to start on (a field with a curriculum only); None:
+                a random row up to `CurriculumConfig.initial_max_level`.
 
         Raises:
             TerrainError: the field has no spawn points (when traced: its shape says so).
@@ -152,10 +176,18 @@ class LeasEnv(Env):
         cfg = self.config
         next_rng, key = jax.random.split(rng)
         n = cfg.reset_attempts
-        u = jax.random.uniform(key, (4 * n + 2,))
-        cand, speed_u, target_u = u[: 4 * n].reshape(n, 4), u[-2], u[-1]
-        count = self.field.spawn_xy.shape[0]
-        idx = jnp.minimum((cand[:, 0] * count).astype(jnp.int32), count - 1)
+        curriculum = self.field.curriculum
+        u = jax.random.uniform(key, (4 * n + 2 + bool(curriculum),))
+        cand, speed_u, target_u = u[: 4 * n].reshape(n, 4), u[4 * n], u[4 * n + 1]
+        if curriculum:
+            if level is None:
+                rows = min(cfg.curriculum.initial_max_level + 1, curriculum["level_count"].shape[0])
+                level = jnp.minimum((u[-1] * rows).astype(jnp.int32), rows - 1)
+            count = curriculum["level_count"][level]
+            first = curriculum["level_start"][level]
+        else:
+            level, count, first = 0, self.field.spawn_xy.shape[0], 0
+        idx = first + jnp.minimum((cand[:, 0] * count).astype(jnp.int32), count - 1)
         jitter = (cand[:, 1:3] - 0.5) * self.field.spawn_spacing
         # the last candidate is the spawn point itself (masks, not scatters: scatters are slow
         # on CPU), and so is every verified start pose (a spawn with its own yaw)
@@ -178,9 +210,10 @@ class LeasEnv(Env):
             jnp.zeros(2),
             jnp.asarray(False),
             next_rng,
+            level,
         )
 
-    def _root(self, pose, speed, target_dir, target_point, follow_point, rng) -> RootState:
+    def _root(self, pose, speed, target_dir, target_point, follow_point, rng, level=0) -> RootState:
         return RootState(
             pos=pose[:3],
             vel=jnp.concatenate([speed * _heading(pose[3]), jnp.zeros(1)]),
@@ -190,6 +223,8 @@ class LeasEnv(Env):
             follow_point=follow_point,
             steps=jnp.zeros((), jnp.int32),
             rng=rng,
+            start=pose[:2],
+            level=jnp.asarray(level, jnp.int32),
         )
 
     def reset_to(self, pose: jax.Array, speed, target_dir=None, target_point=None, rng=None) -> State:

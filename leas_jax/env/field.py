@@ -52,6 +52,9 @@ class Heightfield:
         condition: the learned feasibility condition's parameters
             (`learned_feasibility.LearnedParams`) when `EnvConfig.condition` is "learned",
             else {} (no leaves).
+        curriculum: on a curriculum arena (`with_curriculum`), its rows: "level_start" [L]
+            int32, the index of each row's first spawn point (spawns are sorted by row) and
+            "level_count" [L] int32, its number of spawn points; else {} (no leaves).
     """
 
     heights: jax.Array
@@ -67,6 +70,38 @@ class Heightfield:
     spawn_yaw: jax.Array
     spawn_spacing: jax.Array
     condition: dict = struct.field(default_factory=dict)
+    curriculum: dict = struct.field(default_factory=dict)
+
+
+def with_curriculum(field: Heightfield, curriculum, name: str = "the terrain") -> Heightfield:
+    """The field with its spawn points sorted by curriculum row and the rows' index (host).
+
+    Args:
+        field: the heightfield of a curriculum arena.
+        curriculum: its `leas_jax.terrain.model.Curriculum` layout (rows along x from the
+            field's origin).
+        name: the terrain, for the error.
+
+    Raises:
+        TerrainError: a row has no spawn point (training envs could not start on it).
+    """
+    xy = np.asarray(field.spawn_xy)
+    x0 = float(np.asarray(field.origin)[0])
+    level = np.clip(((xy[:, 0] - x0) // curriculum.tile[0]).astype(np.int64), 0, curriculum.levels - 1)
+    order = np.argsort(level, kind="stable")
+    count = np.bincount(level, minlength=curriculum.levels)
+    if np.any(count == 0):
+        empty = ", ".join(str(k) for k in np.flatnonzero(count == 0))
+        raise TerrainError(f"{name}: curriculum rows {empty} have no spawn position for training episodes")
+    start = np.concatenate([[0], np.cumsum(count)[:-1]])
+    return field.replace(
+        spawn_xy=field.spawn_xy[order],
+        spawn_yaw=field.spawn_yaw[order],
+        curriculum={
+            "level_start": jnp.asarray(start, jnp.int32),
+            "level_count": jnp.asarray(count, jnp.int32),
+        },
+    )
 
 
 def _grid_index(field: Heightfield, x: jax.Array, y: jax.Array):
@@ -346,4 +381,6 @@ def heightfield_from_terrain(
             f"{terrain.path or terrain.name}: no spawn position, a point where a root at nominal height "
             "is valid for every yaw, for training episodes to start at (the terrain is too small or too rough)"
         )
+    if terrain.curriculum is not None and field.spawn_xy.shape[0] > 0:
+        field = with_curriculum(field, terrain.curriculum, terrain.path or terrain.name)
     return field

@@ -83,11 +83,14 @@ def load_params(path: str | Path) -> tuple[LearnedParams, dict]:
 
 
 def condition_params(config: EnvConfig) -> dict:
-    """The learned condition's parameters when `config.condition` is "learned", else {} (host)."""
+    """The network's parameters when `config.condition` is "learned" or "walkability" (both read
+    `config.learned_weights`), else {} (host)."""
     if config.condition == "cylinders":
         return {}
-    if config.condition != "learned":
-        raise ValueError(f"EnvConfig.condition must be 'cylinders' or 'learned', got {config.condition!r}")
+    if config.condition not in ("learned", "walkability"):
+        raise ValueError(
+            f"EnvConfig.condition must be 'cylinders', 'learned' or 'walkability', got {config.condition!r}"
+        )
     path = resolve_data_path(config.learned_weights)
     params, metadata = load_params(path)
     features = len(params["grid"]) + 1 + margin_count(config.reachability)

@@ -208,3 +208,13 @@ def clearance_shortfall(
     every direction, up to 1. pose: [4] (x, y, z, yaw), world -> float[]."""
     ok = jax.vmap(lambda probe: valid(field, probe, config))(shifted_poses(pose, margin))
     return 1.0 - ok.mean()
+
+
+def relaxed_reachability(reach, relaxed_foothold_spread: float | None = None):
+    """The plausible poses' condition: `reach` (a `ReachabilityConfig`) without its lookahead
+    legs (a step model bounds height changes instead) and, unless `relaxed_foothold_spread` is
+    given, without its sole-flatness term (the leg disks must still touch solid ground)."""
+    spread = reach.foothold_spread
+    if spread is not None:
+        spread = None if relaxed_foothold_spread is None else max(spread, relaxed_foothold_spread)
+    return dataclasses.replace(reach, leg_forward=0.0, foothold_spread=spread)

@@ -37,8 +37,9 @@ def fresh_roots(env, root, done: jax.Array):
         done: bool[B], True where the episode ended.
 
     Returns:
-        Batched `RootState` [B]: where done, `env.random_root(root.rng)` (its
-        key advanced for the next reset); elsewhere `root` unchanged.
+        Batched `RootState` [B]: where done, `env.next_root(root)` (`random_root` with its
+        key, advanced for the next reset, on a curriculum arena at its next row); elsewhere
+        `root` unchanged.
     """
     batch = done.shape[0]
     count = done.sum()
@@ -53,9 +54,9 @@ def fresh_roots(env, root, done: jax.Array):
     def gathered(capacity):
         def branch(root):
             if capacity == batch:
-                return select(jax.vmap(env.random_root)(root.rng))
+                return select(jax.vmap(env.next_root)(root))
             idx = jnp.nonzero(done, size=capacity, fill_value=0)[0]  # [capacity] finished envs first
-            drawn = jax.vmap(env.random_root)(root.rng[idx])  # [capacity]
+            drawn = jax.vmap(env.next_root)(jax.tree.map(lambda x: x[idx], root))  # [capacity]
             slot = jnp.clip(jnp.cumsum(done) - 1, 0, capacity - 1)  # [B] rank of each finished env
             return select(jax.tree.map(lambda x: x[slot], drawn))
 

@@ -74,8 +74,8 @@ def cmd_walkability(args) -> int:
     """Label, fit, write the weights and the report; print the report's table."""
     import dataclasses
 
-    from leas_jax.feasibility.families import FAMILIES
     from leas_jax.feasibility.walkability import HELD_OUT, WEIGHTS, WalkabilityConfig, build, report_table
+    from leas_jax.terrain.families import FAMILIES
 
     out = Path(WEIGHTS if args.out is None else args.out)
     if out.suffix != ".npz":

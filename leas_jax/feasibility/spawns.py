@@ -167,4 +167,8 @@ def arena_field(terrain, config, workers=None, progress=True):
     field = heightfield_from_terrain(terrain, config, require_spawn=True)
     if config.spawns == "generator":
         field = verified_spawns(field, terrain, config, workers=workers, progress=progress)
+        if terrain.curriculum is not None:
+            from leas_jax.env.field import with_curriculum
+
+            field = with_curriculum(field, terrain.curriculum, terrain.path or terrain.name)
     return field

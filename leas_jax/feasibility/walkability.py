@@ -34,9 +34,10 @@ import numpy as np
 
 from leas_jax.env import reachability
 from leas_jax.env.field import sample_nearest
-from leas_jax.feasibility.families import FAMILIES, FEATURE_X, family_terrain
+from leas_jax.env.reachability import relaxed_reachability
 from leas_jax.feasibility.label_cache import cached_labels
 from leas_jax.feasibility.walking_truth import WALK_TIMESTEP, dataset_key, walking_guide
+from leas_jax.terrain.families import FAMILIES, FEATURE_X, family_terrain
 
 WEIGHTS = "checkpoints/walkability/walkability.npz"  # the shipped model (relative to the repository)
 HELD_OUT = ("blocks", "stones")  # families kept out of the fit: the report's generalisation test
@@ -56,16 +57,6 @@ class WalkabilityConfig:
     nominal_root_height: float = 1.0  # m above the ground (EnvConfig.nominal_root_height)
     crack_width: float = 0.10  # m, `crack_filled_ground`
     seed: int = 0
-
-
-def relaxed_reachability(reach, relaxed_foothold_spread: float | None = None):
-    """The plausible poses' condition: `reach` (a `ReachabilityConfig`) without its lookahead
-    legs (a step model bounds height changes instead) and, unless `relaxed_foothold_spread` is
-    given, without its sole-flatness term (the leg disks must still touch solid ground)."""
-    spread = reach.foothold_spread
-    if spread is not None:
-        spread = None if relaxed_foothold_spread is None else max(spread, relaxed_foothold_spread)
-    return dataclasses.replace(reach, leg_forward=0.0, foothold_spread=spread)
 
 
 def crack_filled_ground(field, crack_width: float) -> np.ndarray:

@@ -17,7 +17,7 @@ from leas_jax.terrain.loader import load_terrain
 
 
 def register(subparsers) -> None:
-    """Add `terrain` with sub-commands generate, show and export to an argparse sub-parser set."""
+    """Add `terrain` with sub-commands generate, curriculum, show and export to an argparse sub-parser set."""
     parser = subparsers.add_parser(
         "terrain",
         help="generate, show and export terrain files",
@@ -35,6 +35,22 @@ def register(subparsers) -> None:
     gen.add_argument("--out", metavar="FILE", help="output TOML file (default: stdout)")
     gen.add_argument("--eval-dir", metavar="DIR", help="write eval_*.toml into DIR instead of the arena")
     gen.set_defaults(func=cmd_generate)
+
+    curriculum = commands.add_parser(
+        "curriculum",
+        help="write a seeded curriculum arena (rows of difficulty x terrain families)",
+        description="Write a curriculum arena: tiles of procedural terrain families (columns along y) "
+        "in rows of growing difficulty (along x), with its [curriculum] table (to --out or stdout).",
+    )
+    curriculum.add_argument("--seed", type=int, default=0, help="arena seed (default 0)")
+    curriculum.add_argument("--levels", type=int, default=None, help="rows of difficulty (default 8)")
+    curriculum.add_argument(
+        "--families",
+        default=None,
+        help="comma-separated families of the columns (default: all ten, flat first)",
+    )
+    curriculum.add_argument("--out", metavar="FILE", help="output TOML file (default: stdout)")
+    curriculum.set_defaults(func=cmd_curriculum)
 
     show = commands.add_parser(
         "show",
@@ -74,6 +90,33 @@ def cmd_generate(args: argparse.Namespace) -> None:
     if args.seed < 0:
         raise UsageError(f"terrain generate: --seed {args.seed}: must be >= 0")
     text = generate_training_arena(args.seed)
+    if args.out is None:
+        sys.stdout.write(text)
+    else:
+        _write(Path(args.out), text)
+        print(f"wrote {args.out}")
+
+
+def cmd_curriculum(args: argparse.Namespace) -> None:
+    """Write the curriculum arena of `args.seed` to `args.out` (or stdout)."""
+    from leas_jax.terrain.curriculum import CURRICULUM_FAMILIES, CURRICULUM_LEVELS, curriculum_terrain
+    from leas_jax.terrain.families import ALL_FAMILIES
+
+    if args.seed < 0:
+        raise UsageError(f"terrain curriculum: --seed {args.seed}: must be >= 0")
+    levels = CURRICULUM_LEVELS if args.levels is None else args.levels
+    if levels < 1:
+        raise UsageError(f"terrain curriculum: --levels {levels}: must be >= 1")
+    families = CURRICULUM_FAMILIES
+    if args.families is not None:
+        families = tuple(f.strip() for f in args.families.split(",") if f.strip())
+        unknown = [f for f in families if f not in ALL_FAMILIES]
+        if unknown or not families:
+            raise UsageError(
+                f"terrain curriculum: --families {args.families}: unknown {', '.join(unknown) or 'empty list'} "
+                f"(known: {', '.join(ALL_FAMILIES)})"
+            )
+    text = curriculum_terrain(args.seed, levels, families)
     if args.out is None:
         sys.stdout.write(text)
     else:

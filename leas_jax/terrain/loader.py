@@ -16,7 +16,7 @@ import tomllib
 
 from leas_jax.env.config import EnvConfig
 from leas_jax.terrain import sources
-from leas_jax.terrain.model import Box, Scenario, Terrain, TerrainError
+from leas_jax.terrain.model import Box, Curriculum, Scenario, Terrain, TerrainError
 
 MAX_CELLS = 50_000_000  # docs/design.md §4: larger heightfields are rejected
 
@@ -37,7 +37,9 @@ MAX_YAW_DEG = 360.0  # |start_yaw_deg|, and the range spans at most one turn
 # Speeds a scenario may start at: the env's bound on the root speed (EnvConfig.v_max).
 MAX_START_SPEED = EnvConfig().v_max
 
-TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario"} | sources.TOP_KEYS
+TOP_KEYS = {"name", "bounds", "void_height", "resolution", "box", "scenario", "curriculum"} | sources.TOP_KEYS
+CURRICULUM_KEYS = {"levels", "tile", "families"}
+MAX_LEVELS = 100
 TOP_REQUIRED = ("name", "bounds", "void_height", "resolution")
 BOX_KEYS = {"center", "size", "rpy"}
 BOX_REQUIRED = ("center", "size")
@@ -127,6 +129,7 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
     if "scenario" in data:
         scenario = _scenario(check, data["scenario"], bounds)
         check_scenario_ground(check, data["scenario"], scenario, solids, void_height)
+    curriculum = _curriculum(check, data["curriculum"], bounds) if "curriculum" in data else None
     return Terrain(
         name=name,
         bounds=bounds,
@@ -137,7 +140,32 @@ def loads_terrain(text: str, source: str = "<string>", path: str | None = None) 
         text=text,
         path=path,
         meshes=meshes,
+        curriculum=curriculum,
     )
+
+
+def _curriculum(check: _Checker, raw, bounds: np.ndarray) -> Curriculum:
+    """Validate the [curriculum] table: its rows and columns of tiles lie within the bounds."""
+    if not isinstance(raw, dict):
+        check.fail("curriculum", raw, "must be a table ([curriculum])")
+    check.keys(raw, "curriculum", CURRICULUM_KEYS, tuple(sorted(CURRICULUM_KEYS)))
+    levels = check.integer("curriculum.levels", raw["levels"], 1, MAX_LEVELS)
+    tile = check.array("curriculum.tile", raw["tile"], (2,))
+    if np.any(tile <= 0.0):
+        check.fail("curriculum.tile", raw["tile"], "both sides must be > 0")
+    families = raw["families"]
+    if not isinstance(families, list) or not families or not all(isinstance(f, str) for f in families):
+        check.fail("curriculum.families", families, "must be a non-empty array of family names")
+    extent = bounds[1] - bounds[0]
+    needed = np.array([levels * tile[0], len(families) * tile[1]])
+    if np.any(needed > extent + 1e-6):
+        check.fail(
+            "curriculum",
+            raw,
+            f"{levels} rows x {len(families)} columns of {tile[0]:g} x {tile[1]:g} m tiles exceed the bounds' "
+            f"{extent[0]:g} x {extent[1]:g} m",
+        )
+    return Curriculum(levels=levels, tile=(float(tile[0]), float(tile[1])), families=tuple(families))
 
 
 def parse_toml(text: str, source: str) -> dict:

@@ -222,6 +222,23 @@ class Scenario:
             object.__setattr__(self, "waypoints", _frozen_array(self.waypoints, (-1, 2)))
 
 
+@dataclass(frozen=True)
+class Curriculum:
+    """Layout of a curriculum arena (`[curriculum]`): tiles in rows of difficulty along x and
+    columns of terrain families along y, from the terrain's lower bounds corner.
+
+    Attributes:
+        levels: number of rows; row k (x in [x0 + k * tile[0], x0 + (k + 1) * tile[0]]) is
+            difficulty k / (levels - 1).
+        tile: (length along x, width along y) of a tile, m.
+        families: the family of each column, in order along y.
+    """
+
+    levels: int
+    tile: tuple[float, float]
+    families: tuple[str, ...]
+
+
 @dataclass(frozen=True, eq=False)
 class SupportSurface:
     """A convex planar face where a foot may rest.
@@ -297,6 +314,7 @@ class Terrain:
         text: TOML source of the terrain (with its `[resolved]` table for v2 sources).
         path: file the terrain was read from, or None.
         meshes: the `[[mesh]]` entries then the `[elevation]` map, as TerrainMesh (world frame).
+        curriculum: the layout of a curriculum arena's difficulty rows, or None.
     """
 
     name: str
@@ -308,6 +326,7 @@ class Terrain:
     text: str = ""
     path: str | None = None
     meshes: tuple = ()
+    curriculum: Curriculum | None = None
     _cache: dict = field(default_factory=dict, init=False, repr=False)
 
     def __post_init__(self):

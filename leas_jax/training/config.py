@@ -28,6 +28,7 @@ from pathlib import Path
 
 from leas_jax.env.config import (
     CLEARANCE_CONDITIONS,
+    CurriculumConfig,
     EnvConfig,
     HeightmapConfig,
     ReachabilityConfig,
@@ -223,7 +224,12 @@ class TrainConfig:
             # A run saved before an optional term's field existed trained without that term,
             # and the calibrated defaults turn some on: a missing key means the term is off.
             env["reachability"] = {**REACHABILITY_TERMS_OFF, **env["reachability"]}
-        sub = {"reachability": ReachabilityConfig, "heightmap": HeightmapConfig, "rewards": RewardWeights}
+        sub = {
+            "reachability": ReachabilityConfig,
+            "heightmap": HeightmapConfig,
+            "rewards": RewardWeights,
+            "curriculum": CurriculumConfig,
+        }
         env_kwargs = {k: sub[k](**v) if k in sub else v for k, v in env.items()}
         if "hidden_sizes" in data:
             data["hidden_sizes"] = tuple(data["hidden_sizes"])
@@ -244,6 +250,20 @@ class TrainConfig:
 # 3.3 % of the time against 68.3 % without (same section).
 QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.0), clearance_margin=0.10)
 
+# The `generalist` preset: `quick`'s budget, reward terms and clearance term on a curriculum
+# arena (`terrains/curriculum_arena.toml`, `leas terrain curriculum`: 8 rows of difficulty x 10
+# terrain families, envs moved between rows as legged_gym's terrain levels move them,
+# `EnvConfig.curriculum`), terminating on the walkability model of rough ground (fitted on the
+# same families: `leas feasibility walkability`) instead of the arena-fitted condition. The
+# reward terms are `quick`'s: no measurement has yet said to change them.
+GENERALIST_ENV = dataclasses.replace(
+    QUICK_ENV,
+    condition="walkability",
+    learned_weights="checkpoints/walkability/walkability.npz",
+    reachability=ReachabilityConfig(),
+)
+CURRICULUM_ARENA = "terrains/curriculum_arena.toml"
+
 PRESETS = {
     # under a minute on 2 cores, compile included: checks that everything runs
     "smoke": dict(
@@ -259,6 +279,14 @@ PRESETS = {
     "quick": dict(num_timesteps=80_000_000, num_epochs=3, num_minibatches=8, env=QUICK_ENV),
     # the paper's budget and sample reuse: 80 M steps, 10 epochs (Table I), ~25 minutes here
     "paper": dict(num_timesteps=80_000_000, num_epochs=10, num_minibatches=8),
+    # quick's budget on the curriculum arena with the walkability model (GENERALIST_ENV)
+    "generalist": dict(
+        num_timesteps=80_000_000,
+        num_epochs=3,
+        num_minibatches=8,
+        env=GENERALIST_ENV,
+        terrain=CURRICULUM_ARENA,
+    ),
 }
 
 # Planner mode: an iteration is `num_envs` whole episodes (up to 400 steps),

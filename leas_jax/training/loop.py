@@ -17,6 +17,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
+from leas_jax.env.config import NETWORK_CONDITIONS
 from leas_jax.errors import LeasError, UsageError
 from leas_jax.files import resolve_data_path
 from leas_jax.training import checkpoint, records
@@ -326,7 +327,7 @@ def _run_condition_env(run_dir: Path, env):
     environment its policy is evaluated in.
     """
     pinned = run_dir / RUN_CONDITION
-    if env.condition != "learned" or not pinned.is_file():
+    if env.condition not in NETWORK_CONDITIONS or not pinned.is_file():
         return env
     return dataclasses.replace(env, learned_weights=str(pinned))
 
@@ -338,7 +339,7 @@ def _pin_condition(run_dir: Path, env) -> None:
     of another contact generator than the current one: the run would learn to satisfy a
     condition the generator no longer agrees with.
     """
-    if env.condition != "learned" or (run_dir / RUN_CONDITION).is_file():
+    if env.condition not in NETWORK_CONDITIONS or (run_dir / RUN_CONDITION).is_file():
         return
     from leas_jax.env.learned_weights import load_params
     from leas_jax.feasibility.walking_truth import warn_if_stale

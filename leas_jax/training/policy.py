@@ -11,6 +11,7 @@ from typing import Any
 import jax
 import numpy as np
 
+from leas_jax.env.config import NETWORK_CONDITIONS
 from leas_jax.errors import LeasError
 from leas_jax.training.config import TrainConfig
 from leas_jax.training.networks import deterministic_policy_fn
@@ -87,7 +88,7 @@ def load_policy(path: str | Path | Policy, allow_pickle: bool = False) -> Policy
     _check_like(file, "policy_params", params, _expected_params(config))
     _check_like(file, "normalizer", normalizer, _expected_normalizer(config))
     refreshed = file.parent / "condition.npz"
-    if config.env.condition == "learned" and refreshed.is_file():
+    if config.env.condition in NETWORK_CONDITIONS and refreshed.is_file():
         config = dataclasses.replace(
             config, env=dataclasses.replace(config.env, learned_weights=str(refreshed))
         )

@@ -151,6 +151,7 @@ def _unroll(config: TrainConfig, network, state: TrainState, field: Heightfield,
             "invalid_episodes": (done * nstate.metrics["invalid"]).sum(),
             **{k_: v.mean() for k_, v in nstate.metrics.items() if k_.startswith("reward/")},
             "reward": nstate.reward.mean(),
+            "curriculum_level": nstate.pipeline_state.level.mean(),  # 0 without a curriculum
         }
         transition = Transition(
             observation=env_state.obs,

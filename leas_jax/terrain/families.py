@@ -18,6 +18,16 @@ labels hold ground the generator does not walk as well as ground it does:
     generator's feet), a landing, a step of up to 0.15 m down to the ground beyond;
   - clutter: flat ground with 4-10 pillars and walls 0.1-0.5 m wide and 0.05-1.5 m high.
 
+Two more families serve the training curriculum (`leas_jax.terrain.curriculum`) and stay out
+of the walkability model's data (`FAMILIES`): holes (a round hole in flat ground, 0.2-1.6 m
+across) and flat ground.
+
+Drawn without a `difficulty`, a family's parameters are uniform over its ranges (the
+walkability model's data). With a difficulty d in [0, 1] (the curriculum's rows), each
+difficulty parameter sits at the d-quantile of its range, from an easier start where the
+range's low end is not easy (e.g. blocks from 0 deg), jittered by +-0.05: legged_gym's terrain
+levels, with the same families as the walkability model.
+
 A terrain is TOML text (`leas_jax.terrain.loads_terrain`), so a family's terrains are data:
 the walkability model's labels are cached under a hash of that text.
 """
@@ -29,9 +39,48 @@ import math
 import numpy as np
 
 FAMILIES = ("rubble", "blocks", "stairs", "narrow", "stones", "gaps", "slopes", "clutter")
+CURRICULUM_ONLY = ("holes", "flat")  # families of the training curriculum alone
+ALL_FAMILIES = FAMILIES + CURRICULUM_ONLY  # the order seeds each family's draws: append only
+DIFFICULTY_JITTER = 0.05  # +- spread of a difficulty parameter's quantile around d
 SIZE = (6.0, 3.0)  # m, x and y extent of every family terrain
 FEATURE_X = (2.0, 4.4)  # m, where the feature lies along x (flat ground before and after)
 THICKNESS = 0.2  # m, boxes standing on the void hang this far down from their top
+
+
+class _Draw:
+    """Random draws of a family terrain: positions from `rng` as they are; difficulty
+    parameters (`param`) uniform over their range, or at the `difficulty` quantile of it."""
+
+    def __init__(self, rng, difficulty: float | None):
+        self.rng = rng
+        self.difficulty = difficulty
+
+    def uniform(self, *args, **kwargs):
+        return self.rng.uniform(*args, **kwargs)
+
+    def integers(self, *args, **kwargs):
+        return self.rng.integers(*args, **kwargs)
+
+    def param(self, low: float, high: float, easy: float | None = None) -> float:
+        """A difficulty parameter: uniform in [low, high] without a difficulty; else between `easy`
+        (default `low`; `high` may be below it when smaller is harder) and `high` at quantile d."""
+        if self.difficulty is None:
+            return self.rng.uniform(min(low, high), max(low, high))
+        start = low if easy is None else easy
+        quantile = np.clip(
+            self.difficulty + self.rng.uniform(-DIFFICULTY_JITTER, DIFFICULTY_JITTER), 0.0, 1.0
+        )
+        return start + (high - start) * quantile
+
+    def scale(self, value: float) -> float:
+        """An amplitude fixed without a difficulty, scaled by d with one."""
+        return value if self.difficulty is None else value * self.difficulty
+
+    def count(self, low: int, high: int) -> int:
+        """An integer in [low, high) uniformly, or at quantile d."""
+        if self.difficulty is None:
+            return int(self.rng.integers(low, high))
+        return int(low + round((high - 1 - low) * self.difficulty))
 
 
 def _box(center, size, rpy=(0.0, 0.0, 0.0)) -> str:
@@ -53,11 +102,12 @@ def _ground(before: float = FEATURE_X[0], after: float = FEATURE_X[1]) -> list[s
 
 def _rubble(rng) -> list[str]:
     boxes = _ground()
-    tile, crack = 0.3, rng.uniform(0.0, 0.05)
-    tilt = math.radians(rng.uniform(5.0, 30.0))
+    tile, crack = 0.3, rng.param(0.0, 0.05)
+    tilt = math.radians(rng.param(5.0, 30.0, easy=0.0))
+    offset = rng.scale(0.08)
     for x in np.arange(FEATURE_X[0] + tile / 2, FEATURE_X[1], tile):
         for y in np.arange(tile / 2, SIZE[1], tile):
-            top = rng.uniform(-0.08, 0.08)
+            top = rng.uniform(-offset, offset)
             rpy = (rng.uniform(-tilt, tilt), rng.uniform(-tilt, tilt), 0.0)
             boxes.append(_box((x, y, top - 0.05), (tile - crack, tile - crack, 0.1), rpy))
     return boxes
@@ -65,8 +115,8 @@ def _rubble(rng) -> list[str]:
 
 def _blocks(rng) -> list[str]:
     boxes = _ground()
-    height = rng.uniform(0.1, 0.3)
-    tilt = math.radians(rng.uniform(10.0, 25.0))
+    height = rng.param(0.1, 0.3, easy=0.05)
+    tilt = math.radians(rng.param(10.0, 25.0, easy=0.0))
     length, width = 0.4, 0.2
     for k, x in enumerate(np.arange(FEATURE_X[0] + length / 2, FEATURE_X[1], length)):
         for m, y in enumerate(np.arange(width / 2, SIZE[1], width)):
@@ -77,7 +127,7 @@ def _blocks(rng) -> list[str]:
 
 def _stair_tops(rng) -> tuple[list[tuple[float, float, float]], float]:
     """Steps up, a landing, steps down: [(x0, x1, top)], and the x where the ground resumes."""
-    steps, riser, tread = int(rng.integers(2, 5)), rng.uniform(0.05, 0.30), rng.uniform(0.25, 0.35)
+    steps, riser, tread = int(rng.integers(2, 5)), rng.param(0.05, 0.30, easy=0.03), rng.uniform(0.25, 0.35)
     tops, x = [], FEATURE_X[0]
     for k in range(1, steps + 1):
         tops.append((x, x + tread, k * riser))
@@ -96,7 +146,7 @@ def _stairs(rng) -> list[str]:
 
 
 def _narrow(rng) -> list[str]:
-    width = rng.uniform(0.2, 0.6)
+    width = rng.param(0.6, 0.2, easy=1.2)  # narrower is harder
     y0 = SIZE[1] / 2 - width / 2
     if rng.uniform() < 0.5:  # a beam at ground level
         return _ground() + [_slab(FEATURE_X[0], FEATURE_X[1], 0.0, y0, y0 + width)]
@@ -106,24 +156,30 @@ def _narrow(rng) -> list[str]:
 
 def _stones(rng) -> list[str]:
     boxes = _ground()
-    side, gap = rng.uniform(0.2, 0.45), rng.uniform(0.05, 0.50)
+    side, gap = rng.param(0.45, 0.2, easy=0.6), rng.param(0.05, 0.50, easy=0.02)  # smaller stones, wider gaps
     pitch = side + gap
     for x in np.arange(FEATURE_X[0] + gap + side / 2, FEATURE_X[1] - side / 2, pitch):
         for y in np.arange(side / 2 + rng.uniform(0.0, pitch), SIZE[1] - side / 2, pitch):
             boxes.append(
-                _slab(x - side / 2, x + side / 2, rng.uniform(-0.10, 0.10), y - side / 2, y + side / 2)
+                _slab(
+                    x - side / 2,
+                    x + side / 2,
+                    rng.uniform(-rng.scale(0.10), rng.scale(0.10)),
+                    y - side / 2,
+                    y + side / 2,
+                )
             )
     return boxes
 
 
 def _gaps(rng) -> list[str]:
-    width = rng.uniform(0.05, 0.80)
+    width = rng.param(0.05, 0.80, easy=0.0)
     middle = (FEATURE_X[0] + FEATURE_X[1]) / 2
     return [_slab(0.0, middle - width / 2), _slab(middle + width / 2, SIZE[0])]
 
 
 def _slopes(rng) -> list[str]:
-    angle = math.radians(rng.uniform(5.0, 40.0))
+    angle = math.radians(rng.param(5.0, 40.0, easy=0.0))
     run = 1.0
     rise = run * math.tan(angle)
     length = run / math.cos(angle)
@@ -139,7 +195,7 @@ def _slopes(rng) -> list[str]:
 
 def _clutter(rng) -> list[str]:
     boxes = [_slab(0.0, SIZE[0])]
-    for _ in range(int(rng.integers(4, 11))):
+    for _ in range(rng.count(4, 11) if rng.difficulty is None else rng.count(1, 13)):
         sx, sy = rng.uniform(0.1, 0.5, 2)
         if rng.uniform() < 0.3:  # a wall
             sy = rng.uniform(0.6, 1.2)
@@ -147,6 +203,22 @@ def _clutter(rng) -> list[str]:
         x, y = rng.uniform(FEATURE_X[0], FEATURE_X[1]), rng.uniform(0.2, SIZE[1] - 0.2)
         boxes.append(_box((x, y, height / 2), (sx, sy, height), (0.0, 0.0, rng.uniform(0.0, math.pi))))
     return boxes
+
+
+def _holes(rng) -> list[str]:
+    """Flat ground around a square-ish hole over the void (the hole is cut as four slabs)."""
+    side = rng.param(0.2, 1.6)
+    x0 = (FEATURE_X[0] + FEATURE_X[1]) / 2 - side / 2
+    y0 = rng.uniform(0.3, max(0.3, SIZE[1] - 0.3 - side))
+    y1 = min(y0 + side, SIZE[1])
+    boxes = [_slab(0.0, x0), _slab(x0 + side, SIZE[0]), _slab(x0, x0 + side, 0.0, 0.0, y0)]
+    if y1 < SIZE[1]:
+        boxes.append(_slab(x0, x0 + side, 0.0, y1, SIZE[1]))
+    return boxes
+
+
+def _flat(rng) -> list[str]:
+    return [_slab(0.0, SIZE[0])]
 
 
 _BUILDERS = {
@@ -158,20 +230,36 @@ _BUILDERS = {
     "gaps": _gaps,
     "slopes": _slopes,
     "clutter": _clutter,
+    "holes": _holes,
+    "flat": _flat,
 }
 
 
-def family_terrain(family: str, seed: int, resolution: float = 0.02) -> str:
-    """TOML text of the family's terrain drawn from `seed` (deterministic).
+def family_boxes(family: str, seed: int, difficulty: float | None = None) -> list[str]:
+    """The `[[box]]` tables of the family's 6 x 3 m terrain drawn from `seed` (deterministic),
+    at `difficulty` in [0, 1] (None: parameters uniform over their ranges; see the module doc).
 
     Raises:
-        ValueError: an unknown family (the message lists the known ones).
+        ValueError: an unknown family (the message lists the known ones) or a difficulty
+            outside [0, 1].
     """
     if family not in _BUILDERS:
-        raise ValueError(f"unknown terrain family {family!r}: expected one of {', '.join(FAMILIES)}")
-    rng = np.random.default_rng([seed, FAMILIES.index(family)])
+        raise ValueError(f"unknown terrain family {family!r}: expected one of {', '.join(ALL_FAMILIES)}")
+    if difficulty is not None and not 0.0 <= difficulty <= 1.0:
+        raise ValueError(f"difficulty must lie in [0, 1], got {difficulty!r}")
+    rng = np.random.default_rng([seed, ALL_FAMILIES.index(family)])
+    return _BUILDERS[family](_Draw(rng, difficulty))
+
+
+def family_terrain(family: str, seed: int, resolution: float = 0.02, difficulty: float | None = None) -> str:
+    """TOML text of the family's terrain drawn from `seed` (deterministic); see `family_boxes`.
+
+    Raises:
+        ValueError: as `family_boxes`.
+    """
+    boxes = family_boxes(family, seed, difficulty)
     header = (
         f'name = "family_{family}_{seed}"\n'
         f"bounds = [[0.0, 0.0], [{SIZE[0]}, {SIZE[1]}]]\nvoid_height = -2.0\nresolution = {resolution}\n"
     )
-    return header + "\n".join(_BUILDERS[family](rng))
+    return header + "\n".join(boxes)

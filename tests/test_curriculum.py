@@ -1,0 +1,253 @@
+"""The training curriculum: family terrains at a difficulty, curriculum arenas, the env's rows
+(legged_gym's terrain levels) and the walkability model as the env's condition."""
+
+import argparse
+import dataclasses
+import math
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+import tomllib
+
+from leas_jax.env import LeasEnv, heightfield_from_terrain, learned_feasibility, reachability
+from leas_jax.env import condition as env_condition
+from leas_jax.env.config import CurriculumConfig, EnvConfig
+from leas_jax.env.field import with_curriculum
+from leas_jax.errors import UsageError
+from leas_jax.terrain import TerrainError, load_terrain, loads_terrain
+from leas_jax.terrain.commands import register
+from leas_jax.terrain.curriculum import CURRICULUM_FAMILIES, curriculum_terrain
+from leas_jax.terrain.families import ALL_FAMILIES, FAMILIES, family_boxes, family_terrain
+from leas_jax.training.config import GENERALIST_ENV, TrainConfig, preset
+
+TERRAINS = Path(__file__).resolve().parents[1] / "terrains"
+
+
+def _boxes(family, seed, difficulty):
+    return tomllib.loads("\n".join(family_boxes(family, seed, difficulty)))["box"]
+
+
+def _gap_width(seed, difficulty):
+    left, right = _boxes("gaps", seed, difficulty)
+    return (right["center"][0] - right["size"][0] / 2) - (left["center"][0] + left["size"][0] / 2)
+
+
+def _slope_deg(seed, difficulty):
+    ramp = _boxes("slopes", seed, difficulty)[1]
+    return math.degrees(-ramp["rpy"][1])
+
+
+def _beam_width(seed, difficulty):
+    return min(box["size"][1] for box in _boxes("narrow", seed, difficulty))
+
+
+@pytest.mark.parametrize(
+    "measure, harder",
+    [(_gap_width, 1.0), (_slope_deg, 1.0), (_beam_width, -1.0)],
+    ids=["gap", "slope", "beam"],
+)
+def test_a_family_grows_harder_with_its_difficulty(measure, harder):
+    for seed in range(4):
+        values = [measure(seed, d) for d in (0.0, 0.5, 1.0)]
+        assert harder * values[0] < harder * values[1] < harder * values[2], values
+
+
+def test_rubble_at_difficulty_zero_is_level_and_at_one_is_tilted():
+    flat = _boxes("rubble", 1, 0.0)
+    rough = _boxes("rubble", 1, 1.0)
+    tilt = lambda boxes: max(max(abs(b["rpy"][0]), abs(b["rpy"][1])) for b in boxes)  # noqa: E731
+    assert tilt(flat) <= math.radians(0.05 * 30.0) + 1e-4
+    assert tilt(rough) > math.radians(20.0)
+
+
+def test_family_draws_are_seeded_and_every_family_loads():
+    for family in ALL_FAMILIES:
+        for difficulty in (None, 0.0, 1.0):
+            text = family_terrain(family, 5, difficulty=difficulty)
+            assert text == family_terrain(family, 5, difficulty=difficulty)
+            assert loads_terrain(text).boxes
+    # the walkability model's families keep their uniform draws apart from the curriculum's
+    assert family_terrain("gaps", 5) != family_terrain("gaps", 5, difficulty=0.5)
+    assert set(FAMILIES) < set(ALL_FAMILIES)
+
+
+def test_a_difficulty_outside_the_unit_interval_is_refused():
+    with pytest.raises(ValueError, match="difficulty"):
+        family_boxes("rubble", 0, 1.5)
+
+
+def test_a_curriculum_arena_lays_rows_of_difficulty_and_columns_of_families():
+    terrain = loads_terrain(curriculum_terrain(3, levels=3, families=("flat", "gaps")))
+    assert terrain.curriculum.levels == 3 and terrain.curriculum.families == ("flat", "gaps")
+    np.testing.assert_allclose(terrain.bounds, [[0, 0], [18, 6]])
+    heights = terrain.raster()
+    xs, ys = terrain.grid_axes()
+    # the gaps column (y in 3..6): its void widens row after row along x
+    void = heights < terrain.void_height + 1e-6
+    widths = []
+    for level in range(3):
+        rows = (xs >= level * 6) & (xs < level * 6 + 6)
+        widths.append(void[np.ix_(rows, (ys > 4.0) & (ys < 5.0))].all(axis=1).sum())
+    assert widths[0] < widths[1] < widths[2]
+    # the flat column is solid everywhere
+    assert not void[:, (ys > 0.5) & (ys < 2.5)].any()
+
+
+def test_the_committed_curriculum_arena_is_the_generated_one():
+    committed = (TERRAINS / "curriculum_arena.toml").read_text()
+    assert committed == curriculum_terrain(0)
+    assert loads_terrain(committed).curriculum.families == CURRICULUM_FAMILIES
+
+
+@pytest.mark.parametrize(
+    "table, key",
+    [
+        ("[curriculum]\nlevels = 0\ntile = [6, 3]\nfamilies = ['flat']", "curriculum.levels"),
+        ("[curriculum]\nlevels = 2\ntile = [6, 3]\nfamilies = 'flat'", "curriculum.families"),
+        ("[curriculum]\nlevels = 9\ntile = [6, 3]\nfamilies = ['flat']", "curriculum"),
+        ("[curriculum]\nlevels = 1\ntile = [6, -3]\nfamilies = ['flat']", "curriculum.tile"),
+        ("[curriculum]\nlevels = 1\ntile = [6, 3]\nfamilies = ['flat']\nrows = 2", "curriculum.rows"),
+    ],
+)
+def test_a_bad_curriculum_table_names_its_key(table, key):
+    text = family_terrain("flat", 0) + "\n" + table + "\n"
+    with pytest.raises(TerrainError, match=key.replace(".", r"\.")):
+        loads_terrain(text)
+
+
+@pytest.fixture(scope="module")
+def arena():
+    """A small 3-row curriculum arena, its config (cylinders) and field."""
+    terrain = loads_terrain(curriculum_terrain(0, levels=3, families=("flat", "rubble")))
+    config = dataclasses.replace(preset("quick").env, curriculum=CurriculumConfig(initial_max_level=0))
+    return terrain, config, heightfield_from_terrain(terrain, config, require_spawn=True)
+
+
+def test_the_field_sorts_spawns_by_row_and_indexes_the_rows(arena):
+    terrain, _, field = arena
+    start = np.asarray(field.curriculum["level_start"])
+    count = np.asarray(field.curriculum["level_count"])
+    xy = np.asarray(field.spawn_xy)
+    assert count.sum() == len(xy) and (count > 0).all()
+    for level in range(3):
+        rows = xy[start[level] : start[level] + count[level], 0]
+        assert rows.min() >= level * 6.0 and rows.max() < (level + 1) * 6.0
+
+
+def test_a_row_without_spawn_points_is_refused(arena):
+    terrain, _, field = arena
+    only_first_row = field.replace(spawn_xy=field.spawn_xy[:10], spawn_yaw=field.spawn_yaw[:10])
+    with pytest.raises(TerrainError, match="curriculum rows 1, 2"):
+        with_curriculum(only_first_row, terrain.curriculum, "arena.toml")
+
+
+def _ended(env, level, walked):
+    """A root that ended its episode `walked` m from its start on row `level`."""
+    root = env.random_root(jax.random.PRNGKey(level), jnp.asarray(level, jnp.int32))
+    return root.replace(pos=root.pos.at[0].add(walked))
+
+
+def test_envs_move_up_after_a_long_walk_and_down_after_a_short_one(arena):
+    _, config, field = arena
+    env = LeasEnv(field, config)
+    next_row = jax.jit(lambda root: env.next_root(root).level)
+    assert int(next_row(_ended(env, 0, 3.5))) == 1
+    assert int(next_row(_ended(env, 1, 2.0))) == 1  # between the two distances: stays
+    assert int(next_row(_ended(env, 1, 0.5))) == 0
+    assert int(next_row(_ended(env, 0, 0.2))) == 0  # never below the first row
+    past_top = [int(next_row(_ended(env, 2, 4.0).replace(rng=jax.random.PRNGKey(k)))) for k in range(40)]
+    assert set(past_top) == {0, 1, 2}  # past the top: a random row
+
+
+def test_resets_start_on_their_row(arena):
+    _, config, field = arena
+    env = LeasEnv(field, config)
+    draw = jax.jit(jax.vmap(env.random_root))
+    keys = jax.random.split(jax.random.PRNGKey(0), 256)
+    for level in range(3):
+        roots = draw(keys, jnp.full(256, level, jnp.int32))
+        x = np.asarray(roots.pos[:, 0])
+        assert (np.asarray(roots.level) == level).all()
+        assert (x >= level * 6.0 - 0.1).all() and (x < (level + 1) * 6.0 + 0.1).all()
+        np.testing.assert_allclose(np.asarray(roots.start), np.asarray(roots.pos[:, :2]))
+    first = jax.jit(jax.vmap(lambda k: env.random_root(k)))(keys)  # initial_max_level 0
+    assert (np.asarray(first.level) == 0).all()
+
+
+def test_a_field_without_curriculum_keeps_row_zero():
+    terrain = load_terrain(TERRAINS / "training_arena.toml")
+    config = preset("quick").env
+    field = heightfield_from_terrain(terrain, config)
+    env = LeasEnv(field, config)
+    root = env.random_root(jax.random.PRNGKey(1))
+    moved = root.replace(pos=root.pos.at[0].add(5.0))
+    nxt = env.next_root(moved)
+    assert field.curriculum == {} and int(nxt.level) == 0
+    same = env.random_root(root.rng)
+    np.testing.assert_array_equal(np.asarray(nxt.pos), np.asarray(same.pos))
+
+
+def test_the_walkability_condition_is_the_plausible_cylinders_and_the_network():
+    terrain = loads_terrain(family_terrain("rubble", 2))
+    config = GENERALIST_ENV
+    field = heightfield_from_terrain(terrain, config)
+    rng = np.random.default_rng(0)
+    n = 400
+    poses = np.stack(
+        [rng.uniform(0.3, 5.7, n), rng.uniform(0.3, 2.7, n), rng.uniform(0.7, 1.3, n), rng.uniform(-3, 3, n)],
+        axis=1,
+    ).astype(np.float32)
+    verdict = jax.jit(jax.vmap(lambda p: env_condition.valid(field, p, config)))(poses)
+    network = jax.vmap(lambda p: learned_feasibility.valid(field.condition, field, p, config.reachability))(
+        poses
+    )
+    plausible = jax.vmap(
+        lambda p: reachability.valid(field, p, reachability.relaxed_reachability(config.reachability))
+    )(poses)
+    np.testing.assert_array_equal(np.asarray(verdict), np.asarray(network & plausible))
+    assert 0 < int(verdict.sum()) < n and int((np.asarray(network) & ~np.asarray(plausible)).sum()) > 0
+
+
+def test_the_generalist_preset_trains_on_the_curriculum_with_the_walkability_model():
+    config = preset("generalist")
+    assert config.env.condition == "walkability"
+    assert load_terrain(config.terrain_path()).curriculum is not None
+    assert TrainConfig.from_dict(config.to_dict()) == config
+    legacy = config.to_dict()
+    del legacy["env"]["curriculum"]  # a run saved before the curriculum existed
+    assert TrainConfig.from_dict(legacy).env.curriculum == CurriculumConfig()
+    with pytest.raises(ValueError, match="condition"):
+        env_condition.valid(
+            heightfield_from_terrain(load_terrain(TERRAINS / "eval_ground.toml")),
+            jnp.zeros(4),
+            dataclasses.replace(EnvConfig(), condition="walkability"),
+        )
+
+
+def run(*argv):
+    parser = argparse.ArgumentParser(prog="leas")
+    register(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["terrain", *argv])
+    args.func(args)
+
+
+def test_the_curriculum_command_writes_a_seeded_arena(tmp_path):
+    out = tmp_path / "arena.toml"
+    run("curriculum", "--seed", "4", "--levels", "2", "--families", "flat,holes", "--out", str(out))
+    assert out.read_text() == curriculum_terrain(4, 2, ("flat", "holes"))
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (("--seed", "-1"), "--seed -1"),
+        (("--levels", "0"), "--levels 0"),
+        (("--families", "flat,lava"), "unknown lava"),
+    ],
+)
+def test_curriculum_command_errors_name_the_argument(argv, message):
+    with pytest.raises(UsageError, match=message):
+        run("curriculum", *argv)

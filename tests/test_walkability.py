@@ -14,8 +14,8 @@ import pytest
 
 from leas_jax.env.config import ReachabilityConfig
 from leas_jax.feasibility import walkability as wk
-from leas_jax.terrain.families import FAMILIES, family_terrain
 from leas_jax.terrain import loads_terrain
+from leas_jax.terrain.families import FAMILIES, family_terrain
 
 CONFIG = wk.WalkabilityConfig()
 

@@ -216,6 +216,10 @@ def test_the_generalist_preset_trains_on_the_curriculum_with_the_walkability_mod
     assert config.env.condition == "walkability"
     assert load_terrain(config.terrain_path()).curriculum is not None
     assert TrainConfig.from_dict(config.to_dict()) == config
+    planner = preset("generalist", mode="planner")  # `leas run --preset generalist`'s fine-tuning
+    assert (
+        planner.terrain == config.terrain and planner.env == config.env and planner.pretrain == "generalist"
+    )
     legacy = config.to_dict()
     del legacy["env"]["curriculum"]  # a run saved before the curriculum existed
     assert TrainConfig.from_dict(legacy).env.curriculum == CurriculumConfig()
@@ -251,3 +255,22 @@ def test_the_curriculum_command_writes_a_seeded_arena(tmp_path):
 def test_curriculum_command_errors_name_the_argument(argv, message):
     with pytest.raises(UsageError, match=message):
         run("curriculum", *argv)
+
+
+def test_the_generalist_study_tabulates_pooled_coverage_with_intervals():
+    import sys
+
+    sys.path.insert(0, str(TERRAINS.parent / "studies"))
+    import generalist
+
+    row = {"guides": 32, "fully_covered": 30, "mean_progress_m": 3.0}
+    results = {
+        "policies": {"a": "run_a"},
+        "arenas": {
+            "a": {"random_10x10_V5": {"0": row, "1": {**row, "fully_covered": 28, "mean_progress_m": 2.0}}}
+        },
+        "scenarios": {"a": {"terrains/eval_stairs.toml": {"n": 20, "success": 19, "mean_coverage": 0.99}}},
+    }
+    text = generalist.markdown(results)
+    assert "| random_10x10_V5 | 90.6 [81.0, 95.6] (n 64) | 2.50 |" in text
+    assert "| eval_stairs | 95.0 [76.4, 99.1] (99) |" in text

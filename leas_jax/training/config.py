@@ -312,6 +312,17 @@ PLANNER_PRESETS = {
         num_timesteps=150_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick", env=QUICK_ENV
     ),
     "paper": dict(num_timesteps=600_000, num_envs=64, num_minibatches=4, num_epochs=10, pretrain="paper"),
+    # `quick`'s fine-tuning of the generalist pretrain; its episodes start on rows 0 to
+    # CurriculumConfig.initial_max_level of the curriculum (the rows move with geometric episodes)
+    "generalist": dict(
+        num_timesteps=150_000,
+        num_envs=64,
+        num_minibatches=4,
+        num_epochs=4,
+        pretrain="generalist",
+        env=GENERALIST_ENV,
+        terrain=CURRICULUM_ARENA,
+    ),
 }
 
 

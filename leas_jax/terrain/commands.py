@@ -90,11 +90,7 @@ def cmd_generate(args: argparse.Namespace) -> None:
     if args.seed < 0:
         raise UsageError(f"terrain generate: --seed {args.seed}: must be >= 0")
     text = generate_training_arena(args.seed)
-    if args.out is None:
-        sys.stdout.write(text)
-    else:
-        _write(Path(args.out), text)
-        print(f"wrote {args.out}")
+    _emit(text, args.out)
 
 
 def cmd_curriculum(args: argparse.Namespace) -> None:
@@ -117,11 +113,7 @@ def cmd_curriculum(args: argparse.Namespace) -> None:
                 f"(known: {', '.join(ALL_FAMILIES)})"
             )
     text = curriculum_terrain(args.seed, levels, families)
-    if args.out is None:
-        sys.stdout.write(text)
-    else:
-        _write(Path(args.out), text)
-        print(f"wrote {args.out}")
+    _emit(text, args.out)
 
 
 def cmd_show(args: argparse.Namespace) -> None:
@@ -149,6 +141,15 @@ def cmd_export(args: argparse.Namespace) -> None:
         )
     export_terrain(load_terrain(args.file), out)
     print(f"wrote {out}")
+
+
+def _emit(text: str, out: str | None) -> None:
+    """Write `text` to the file `out`, or to stdout when `out` is None."""
+    if out is None:
+        sys.stdout.write(text)
+    else:
+        _write(Path(out), text)
+        print(f"wrote {out}")
 
 
 def _write(path: Path, text: str) -> None:

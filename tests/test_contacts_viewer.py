@@ -343,7 +343,8 @@ def _rollout_view(tmp_path, fall_at=None):
 
     from leas_jax.motion.commands import write_rollout_html
 
-    base = example_robot_data.load("talos").model.referenceConfigurations["half_sitting"]
+    talos = example_robot_data.load("talos")
+    base = talos.model.referenceConfigurations["half_sitting"].copy()  # not a view into the model
     n = 301
     q = np.tile(base, (n, 1))
     q[:, 0] = np.linspace(0.0, 0.3, n)

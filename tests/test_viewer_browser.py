@@ -42,13 +42,15 @@ size = [1.0, 2.0, 1.0]
 """
 
 
-def screenshot(page, tmp_path, cam, name="shot"):
+def screenshot(page, tmp_path, cam, name="shot", frame=None):
     """RGB [HEIGHT, WIDTH, 3] uint8 of `page` drawn with the panel hidden at camera
-    cam = (azimuth, elevation, distance, target x, y, z)."""
+    cam = (azimuth, elevation, distance, target x, y, z) and, if given, the robot's `frame`."""
     from PIL import Image
 
     out = tmp_path / f"{name}.png"
-    fragment = "panel=0&cam=" + ",".join(f"{v:.6g}" for v in cam)
+    fragment = (
+        "panel=0&cam=" + ",".join(f"{v:.6g}" for v in cam) + ("" if frame is None else f"&frame={frame}")
+    )
     done = subprocess.run(
         [
             CHROMIUM,
@@ -165,3 +167,46 @@ def test_a_mesh_scene_shows_its_platform_apart_from_the_floor(tmp_path):
         assert (np.abs(surface - colour).max(axis=1) < 12).mean() > 0.8
         colours.append(colour)
     assert np.abs(colours[0] - colours[1]).max() > 40, "platform and floor look alike"
+
+
+GROUND = """
+name = "ground"
+bounds = [[-1.5, -1.5], [1.5, 1.5]]
+void_height = -2.0
+resolution = 0.02
+
+[[box]]
+center = [0.0, 0.0, -0.1]
+size = [3.0, 3.0, 0.2]
+"""
+
+
+def test_a_motion_page_draws_the_ghost_and_the_simulated_robot_where_they_stand(tmp_path):
+    """Planned Talos (ghost) at y = -0.4, simulated at y = +0.4, seen from -x: translucent blue where
+    the ghost's torso is, the robot's own grey where the simulated one's is, at the frame the URL asks."""
+    import example_robot_data
+
+    talos = example_robot_data.load("talos")
+    base = talos.model.referenceConfigurations["half_sitting"].copy()  # not a view into the model
+    planned, simulated = np.tile(base, (3, 1)), np.tile(base, (3, 1))
+    planned[:, 1], simulated[:, 1] = -0.4, 0.4
+    planned[2, 1], simulated[2, 1] = -1.3, 1.3  # both step 0.9 m aside at the last frame
+    page = tmp_path / "motion.html"
+    tracks = [("planned", planned, (0.35, 0.6, 1.0, 0.35)), ("simulated", simulated, None)]
+    viewer.write_motion_html(page, GROUND, np.full((1, 2, 7), np.nan), tracks, 0.04)
+    reference = tmp_path / "ground.html"
+    viewer.write_html(box_plan(GROUND), reference)
+    cam = (np.pi, 0.15, 3.5, 0.0, 0.0, 0.9)
+    empty = screenshot(reference, tmp_path, cam, "empty")
+    torso = np.array([[0.0, -0.4, base[2] + 0.15], [0.0, 0.4, base[2] + 0.15]])
+    for frame, present in ((0, True), (2, False)):
+        image = screenshot(page, tmp_path, cam, f"frame{frame}", frame=frame)
+        ghost, solid = (patch(image, p, half=2).mean(axis=0) for p in project(torso, cam))
+        ghost_empty, solid_empty = (patch(empty, p, half=2).mean(axis=0) for p in project(torso, cam))
+        if not present:  # both robots stepped aside: the scene behind shows again
+            assert np.abs(ghost - ghost_empty).max() < 10 and np.abs(solid - solid_empty).max() < 10
+            continue
+        assert np.abs(solid - solid_empty).max() > 40, "the simulated robot is not drawn"
+        assert abs(solid[2] - solid[0]) < 20, "the simulated robot is tinted"
+        assert np.abs(ghost - ghost_empty).max() > 20, "the ghost is not drawn"
+        assert ghost[2] - ghost[0] > 25, "the ghost is not translucent blue"

@@ -7,10 +7,12 @@ commanded torques come to the URDF's effort limits (peak ratio per joint group);
 much CPU time do motion generation and simulation cost per second of motion?
 
 Plans: each scenario's seeded starts (as `leas evaluate` draws them; `ground` is Table II's
-nine cells of yaw range x initial speed, `--starts` per cell there) steered by RBLin
-(straight lines to the target, `leas_jax.steering.baselines`) and planned by the contact
-generator in this process; a plan counts when it covers its whole guide (the generator's
-verified plans, `leas_jax.eval.motions.covers_guide`). The HPP group's demo queries
+nine cells of yaw range x initial speed, `--ground-starts` per cell there) steered by
+RBLin (straight lines to the target, `leas_jax.steering.baselines`) or, where straight
+lines do not reach (METHODS: bridges, holes, the Bauzil room), by `navigate` with the
+shipped policy (`--checkpoint`), and planned by the contact generator in this process; a
+plan counts when it covers its whole guide (the generator's verified plans,
+`leas_jax.eval.motions.covers_guide`). The HPP group's demo queries
 (terrains/hpp/demos/*.toml) hold one start each. Plans are cached in
 `<plans>/<scenario>_<k>.npz` (default runs/motion_plans/, not committed), so a later run
 (another `--variant`) executes the same plans.
@@ -48,6 +50,15 @@ ROOT = Path(__file__).resolve().parents[1]
 TARGET = ("ground", "stairs", "bridge", "hpp_talos_stairs10", "hpp_talos_navBauzil")
 # The other evaluation scenarios and HPP scenes (75 % over all scenes with a verified plan).
 OTHERS = ("hole", "stairs_side", "hpp_stairs", "hpp_bridge", "hpp_hole", "hpp_talos_flatGround")
+# Steering method per scenario (default rblin): navigate where RBLin's straight lines meet
+# no verified plan (eval_bridge: 0 of 4 starts; the Bauzil room's demo query).
+METHODS = {
+    "bridge": "navigate",
+    "hole": "navigate",
+    "hpp_talos_navBauzil": "navigate",
+    "hpp_bridge": "navigate",
+    "hpp_hole": "navigate",
+}
 # Scenario name -> terrain file for the HPP scenes (the evaluation scenarios by name).
 HPP_FILES = {
     "hpp_talos_stairs10": "terrains/hpp/demos/talos_stairs10.toml",
@@ -69,7 +80,7 @@ def wilson(successes: int, n: int, z: float = 1.96) -> tuple[float, float]:
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
-def make_plans(name: str, starts: int, ground_starts: int, cache: Path) -> list[Path]:
+def make_plans(name: str, starts: int, ground_starts: int, cache: Path, checkpoint=None) -> list[Path]:
     """Plan files of `name`'s covered RBLin plans, planned now unless cached.
 
     Args:
@@ -77,6 +88,7 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path) -> list[
         starts: starts of a one-cell scenario (HPP demos: their one start).
         ground_starts: starts per cell of `ground` (Table II's nine cells).
         cache: folder of the plan files.
+        checkpoint: the policy of the navigate method (METHODS).
 
     Returns:
         paths of the covered plans' files (world frame, the generator's ContactPlan format).
@@ -93,7 +105,13 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path) -> list[
     began = time.perf_counter()
     # ground: per cell of nine; the HPP demos: their one query; the other scenes: `starts`.
     per_cell = ground_starts if name == "ground" else (None if name.startswith("hpp_talos") else starts)
-    result = run_scenario(name, terrain, ("rblin",), None, per_cell, 0, progress=False)
+    method = METHODS.get(name, "rblin")
+    policy = None
+    if method == "navigate":
+        from leas_jax.eval.evaluate import policy_for
+
+        policy = policy_for((method,), checkpoint)
+    result = run_scenario(name, terrain, (method,), policy, per_cell, 0, progress=False)
     files = []
     for k, trajectory in enumerate(result.trajectories):
         if covers_guide(trajectory):
@@ -103,6 +121,7 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path) -> list[
     marker.write_text(
         json.dumps(
             {
+                "method": method,
                 "starts": len(result.trajectories),
                 "plans": files,
                 "planning_seconds": round(time.perf_counter() - began, 1),
@@ -118,9 +137,18 @@ def cause(summary: dict) -> str:
     None when the plan executes."""
     if not summary["made"]:
         error = summary["error"] or ""
-        for key in ("equilibrium", "torque", "velocity", "joint limit", "IK", "terrain", "transition"):
+        for key, label in (
+            ("equilibrium", "equilibrium"),
+            ("out of the legs' reach", "soles out of reach"),
+            ("torque", "torque"),
+            ("velocity", "velocity"),
+            ("joint limit", "joint limit"),
+            ("IK", "IK"),
+            ("inside the terrain", "swing sole in the terrain"),
+            ("contacts", "transition"),
+        ):
             if key.lower() in error.lower():
-                return f"no motion: {key}"
+                return f"no motion: {label}"
         return "no motion: other"
     if summary["success"]:
         return None
@@ -162,8 +190,11 @@ def run(args) -> dict:
         "scenarios": {},
     }
     json_path = out / f"motion_execution_{args.variant}.json"
+    if json_path.is_file() and args.scenarios:  # a run of some scenarios adds to the variant's others
+        previous = json.loads(json_path.read_text())
+        report["scenarios"] = {k: v for k, v in previous["scenarios"].items() if k not in names}
     for name in names:
-        plans = make_plans(name, args.starts, args.ground_starts, cache)
+        plans = make_plans(name, args.starts, args.ground_starts, cache, args.checkpoint)
         if args.max_plans:
             plans = plans[: args.max_plans]
         executions = []
@@ -179,6 +210,7 @@ def run(args) -> dict:
             )
         marker = json.loads((cache / f"{name}.json").read_text())
         report["scenarios"][name] = {
+            "method": marker.get("method", "rblin"),
             "starts": marker["starts"],
             "verified_plans": len(marker["plans"]),
             "executions": executions,
@@ -258,21 +290,21 @@ def markdown(report: dict) -> str:
         f"# Motion execution: variant `{report['variant']}`",
         "",
         f"MotionConfig overrides: `{json.dumps(report['motion_config'])}`; SimulationConfig overrides: "
-        f"`{json.dumps(report['simulation_config'])}`. RBLin plans: {report['starts']} start(s) per scenario, {report['ground_starts_per_cell']} per cell of ground's nine.",
+        f"`{json.dumps(report['simulation_config'])}`. Plans of each scenario's method: {report['starts']} start(s) per scenario, {report['ground_starts_per_cell']} per cell of ground's nine.",
         "",
-        "| scenario | starts | verified plans | executed (95 % Wilson) | made, no fall | failures by cause |",
-        "|---|---|---|---|---|---|",
+        "| scenario | method | starts | verified plans | executed (95 % Wilson) | made, no fall | failures by cause |",
+        "|---|---|---|---|---|---|---|",
     ]
     for name, row in s["scenarios"].items():
         sc = report["scenarios"][name]
         causes = ", ".join(f"{k}: {v}" for k, v in sorted(row["causes"].items())) or "-"
         lines.append(
-            f"| {name} | {sc['starts']} | {sc['verified_plans']} | {_pct(row['executed'])} "
+            f"| {name} | {sc.get('method', 'rblin')} | {sc['starts']} | {sc['verified_plans']} | {_pct(row['executed'])} "
             f"| {_pct(row['made_and_upright'])} | {causes} |"
         )
     lines += [
-        f"| **target group** | | | {_pct(s['totals']['target'])} | | |",
-        f"| **all scenes** | | | {_pct(s['totals']['all'])} | | |",
+        f"| **target group** | | | | {_pct(s['totals']['target'])} | | |",
+        f"| **all scenes** | | | | {_pct(s['totals']['all'])} | | |",
         "",
         "Peak commanded torque / effort limit over every simulated motion, per joint group: "
         + ", ".join(f"{k} {v:.2f}" for k, v in s["peak_torque_ratio_by_group"].items()),
@@ -301,6 +333,9 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default=str(ROOT / "benchmarks/results/motion"))
     parser.add_argument("--starts", type=int, default=4, help="starts of a one-cell scenario")
     parser.add_argument("--ground-starts", type=int, default=1, help="starts per cell of ground (9 cells)")
+    parser.add_argument(
+        "--checkpoint", default=str(ROOT / "checkpoints/leas_talos"), help="navigate's policy"
+    )
     parser.add_argument("--plans", default=str(ROOT / "runs/motion_plans"), help="plan cache folder")
     parser.add_argument(
         "--all", action="store_true", help="also the other evaluation scenarios and HPP scenes"

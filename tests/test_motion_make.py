@@ -24,6 +24,7 @@ def test_key_instants_are_the_plan_postures(plan, motion):
     assert len(motion.key_index) == len(plan)
     assert motion.key_index[0] == 0 and motion.key_index[-1] == len(motion.q) - 1
     np.testing.assert_array_equal(motion.q[motion.key_index], plan.q)
+    assert motion.moved_keys.size == 0  # every posture of this plan is well inside its support
     np.testing.assert_array_equal(motion.contact[motion.key_index], ~np.isnan(plan.feet[:, :, 0]))
     # at rest at every key posture
     assert np.abs(motion.v[motion.key_index]).max() < 1e-3 < np.abs(motion.v).max()

@@ -106,10 +106,13 @@ def test_talos_climbs_eval_stairs_in_mujoco():
 
 
 @pytest.mark.slow
-def test_a_posture_on_the_edge_of_its_support_fails_the_equilibrium_check():
+def test_a_posture_on_the_edge_of_its_support_is_reached_with_its_com_inside():
     """The generator's posture 16 of this plan has its CoM near the soles' edge (hpp robustness 6.8,
-    most postures ~95): the CoM cannot leave it with an acceleration, and MuJoCo's Talos falls
-    in that shift (measured with check=False)."""
+    most postures ~95): as the plan's own, the CoM cannot leave it with an acceleration (and
+    MuJoCo's Talos falls in that shift, measured with check=False); with the support margin the
+    motion reaches it with its CoM moved inside and passes every check."""
     plan = stairs_plan(3.5, 2.8, 0.18)
     with pytest.raises(MotionError, match="shift between postures 16 and 17 .*equilibrium fails"):
-        make_motion(plan)
+        make_motion(plan, MotionConfig(support_margin=0.0))
+    motion = make_motion(plan)
+    assert 16 in motion.moved_keys.tolist()

@@ -43,6 +43,15 @@ class MotionConfig:
     # eval_stairs: 0.05 rad drives the swing knee past its 7 rad/s limit at lift-off).
     lean: float = 0.015
     min_knee: float = 0.3
+    # Double-support key postures whose CoM lies closer than this to the edge of their soles'
+    # support polygon (convex hull of both soles' corners, horizontal projection), m, are
+    # reached with their CoM moved towards the polygon's centre until it is this far inside
+    # (whole-body IK, soles, root orientation and upper body kept). The contact generator
+    # puts some landing postures' CoM at their heels (eval_stairs: 4.5-7 mm inside, hpp
+    # robustness 2-7 where most postures have ~95): the motion's shift there then fails the
+    # equilibrium check with the CoM's acceleration, or Talos tips over backwards in MuJoCo
+    # when its tracking error exceeds that margin. 0: every key posture is the plan's own.
+    support_margin: float = 0.03
     # Single support lasts longer than lift_duration or land_duration where the CoM moves
     # far (the root comes down and up on steps): its peak acceleration along the
     # minimum-jerk move stays under this, m/s^2 (on eval_stairs a 0.11 m move in 0.6 s,
@@ -88,6 +97,11 @@ class SimulationConfig:
     # over. Leg kp is at least `leg_stiffness`, N m/rad (4 x that), with kd for damping
     # ratio `zeta` on the joint's own inertia.
     leg_stiffness: float = 3000.0
+    # Land each swing sole on its planned world placement (`simulate.LandingCorrection`):
+    # the robot creeps under MuJoCo's soft frictional contacts (tenths of a millimetre per
+    # phase, the whole robot with its soles), and without it the landing error passes 3 cm
+    # after 130-240 s of motion on flat ground and on eval_stairs. False: joint references alone.
+    landing_correction: bool = True
     # Seconds simulated after the motion's last sample (the robot must stay up).
     settle: float = 0.5
     # Success: the root (base_link) stays above `min_root_height` over the higher sole in

@@ -119,11 +119,15 @@ class Motion:
         feet: [N, 2, 7] reference sole placements (xyz + quaternion xyzw), world; the
             swing sole's moves along its path.
         com: [N, 3] CoM, world, m.
-        key_index: [K] sample index of each plan posture (q[key_index] == plan.q).
+        key_index: [K] sample index of each plan posture (q[key_index] == plan.q, except at
+            the moved_keys).
         phases: tuple of Phase, in time order.
         plan_q: [K, 39], plan_feet: [K, 2, 7]: the plan's postures and placements.
         terrain: the terrain file's text.
         dt: sampling period, s.
+        moved_keys: [J] plan postures reached with their CoM moved inside the support polygon
+            (`MotionConfig.support_margin`, `centred_postures`): same soles, root orientation
+            and upper body, another root position and leg joints.
     """
 
     time: np.ndarray
@@ -141,6 +145,7 @@ class Motion:
     plan_feet: np.ndarray
     terrain: str
     dt: float
+    moved_keys: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     failures: list = field(default_factory=list)
 
     @property
@@ -180,6 +185,7 @@ class Motion:
             plan_feet=self.plan_feet,
             terrain=np.str_(self.terrain),
             dt=np.float64(self.dt),
+            moved_keys=np.asarray(self.moved_keys, dtype=np.int64),
         )
         atomic_write_bytes(os.fspath(path), buffer.getvalue())
 
@@ -203,6 +209,8 @@ class Motion:
             if missing:
                 raise MotionError(f"{path}: missing key '{missing[0]}' (not a motion file?)")
             arrays = {key: data[key] for key in MOTION_KEYS}
+            # files written before key postures were moved have no moved_keys: none moved
+            moved = data["moved_keys"] if "moved_keys" in data.files else np.zeros(0, dtype=np.int64)
         n = len(arrays["time"])
         shapes = {
             "q": (n, 39),
@@ -249,6 +257,7 @@ class Motion:
             plan_feet=arrays["plan_feet"],
             terrain=str(arrays["terrain"]),
             dt=float(arrays["dt"]),
+            moved_keys=np.asarray(moved, dtype=np.int64).reshape(-1),
         )
 
 
@@ -473,6 +482,74 @@ def single_support_coms(
     return coms
 
 
+def support_margin(points: np.ndarray, point: np.ndarray) -> float:
+    """Signed distance, m, of point [2] inside the convex hull of points [P, 2] (negative outside)."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(points)
+    return float(-(hull.equations[:, :2] @ point + hull.equations[:, 2]).max())
+
+
+def sole_corners(feet: np.ndarray, on) -> np.ndarray:
+    """Horizontal corners [4 S, 2] (world) of the soles in contact: feet [2, 4, 4] placements,
+    on [2] bool."""
+    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
+
+    corners = np.array(
+        [[sx * SOLE_LENGTH / 2, sy * SOLE_WIDTH / 2, 0.0] for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+    )
+    return np.concatenate([feet[s][:3, 3] + corners @ feet[s][:3, :3].T for s in (0, 1) if on[s]])[:, :2]
+
+
+def centred_com(points: np.ndarray, com: np.ndarray, margin: float) -> np.ndarray:
+    """The CoM [3] moved horizontally towards the centroid of points [P, 2] (a support polygon's
+    corners, world) until it is `margin` m inside their convex hull, its height kept; the
+    centroid when no point of that segment is; `com` itself when it already is."""
+    centre = points.mean(axis=0)
+    if support_margin(points, com[:2]) >= margin:
+        return com.copy()
+    low, high = 0.0, 1.0
+    if support_margin(points, centre) >= margin:
+        for _ in range(30):  # the margin is concave along the segment: bisection finds its crossing
+            middle = 0.5 * (low + high)
+            if support_margin(points, com[:2] + middle * (centre - com[:2])) >= margin:
+                high = middle
+            else:
+                low = middle
+    out = com.copy()
+    out[:2] = com[:2] + high * (centre - com[:2])
+    return out
+
+
+def centred_postures(talos, plan: ContactPlan, frames, margin: float, ik) -> tuple[np.ndarray, list[int]]:
+    """The plan's postures [K, 39] with every double-support posture after the first whose CoM
+    is less than `margin` m inside its soles' support polygon moved (`centred_com`, whole-body
+    IK from the posture: soles, root orientation and upper body kept), and the moved indices.
+
+    A posture the IK cannot move (IKError) stays the plan's.
+    """
+    from leas_jax.motion.wbik import IKError, Targets
+
+    q = np.array(plan.q, dtype=np.float64)
+    moved = []
+    if margin <= 0.0:
+        return q, moved
+    for k in range(1, len(plan)):
+        on = _contacts(plan, k)
+        if not on.all():
+            continue
+        feet, com, rotation = frames[k]
+        target = centred_com(sole_corners(feet, on), com, margin)
+        if np.allclose(target, com):
+            continue
+        try:
+            q[k] = ik.solve(q[k], Targets(feet, target, rotation, q[k]))
+        except IKError:
+            continue
+        moved.append(k)
+    return q, moved
+
+
 def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) -> list[_PhaseSpec]:
     """Phases from plan posture k to k + 1.
 
@@ -691,11 +768,16 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
         raise MotionError(f"the plan has {len(plan)} posture(s); a motion needs at least 2")
     talos = load_talos()
     terrain = loads_terrain(plan.terrain, source="<plan terrain>")
+    ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
+    original = plan
     frames = [posture_frames(talos, q) for q in plan.q]
+    keys, moved = centred_postures(talos, plan, frames, config.support_margin, ik)
+    if moved:
+        plan = dataclasses.replace(plan, q=keys)
+        frames = [posture_frames(talos, q) for q in plan.q]
     specs = []
     for k in range(len(plan) - 1):
         specs.extend(_segment_phases(plan, k, frames, terrain, config, talos))
-    ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
     q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
     contact_samples.append(_contacts(plan, 0))
     phases, key_index = [], [0]
@@ -745,8 +827,9 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
         com=np.array(com_samples),
         key_index=np.array(key_index),
         phases=tuple(phases),
-        plan_q=np.array(plan.q),
-        plan_feet=np.array(plan.feet),
+        plan_q=np.array(original.q),
+        plan_feet=np.array(original.feet),
+        moved_keys=np.array(moved, dtype=np.int64),
         terrain=plan.terrain,
         dt=config.dt,
     )

@@ -229,6 +229,7 @@ def simulate(
     q_joint, dq_joint = mj.qpos_index, mj.dof_index
     actuators = mj.actuator_index
     joint_ratio = np.zeros(len(effort))
+    landing = LandingCorrection(talos, motion) if config.landing_correction else None
     for step in range(steps + 1):
         position = min(step / stride, len(motion.q) - 1)
         sample = int(position)
@@ -236,8 +237,12 @@ def simulate(
             _close_phase(results[phase_index], motion, phase_index, data, mj)
             phase_index += 1
             anchors = [None, None]
+            if landing is not None:
+                landing.begin(phase_index, data.site_xpos[list(mj.sole_sites), :2])
         result = results[phase_index]
         q_ref = _interpolate(motion.q[:, 7:], position)
+        if landing is not None:
+            q_ref = q_ref + landing.offset(phase_index, position)
         v_ref = _interpolate(motion.v[:, 6:], position)
         command = kp * (q_ref - data.qpos[q_joint]) + kd * (v_ref - data.qvel[dq_joint])
         if feedforward:
@@ -300,6 +305,77 @@ def simulate(
         joint_torque_ratio=joint_ratio,
         cpu_seconds=clock.process_time() - cpu_started,
     )
+
+
+class LandingCorrection:
+    """Joint-reference offsets [32] that land each swing sole on its planned world placement.
+
+    The tracked robot creeps: its supporting soles slide by tenths of a millimetre per phase
+    (well under `max_slip`), the whole robot with them, and a swing leg that tracks its
+    joint references lands its sole where the plan puts it relative to the stance sole, not
+    in the world: on flat ground and on eval_stairs the landing error passes 3 cm after
+    130-240 s of motion. At the start of every phase the supporting soles' horizontal
+    offsets e (world, simulated minus the motion's reference) are read and each leg is
+    given a sole offset t relative to the root for the phase's end:
+
+    - double support: t = e - mean(e) (the legs agree with where the soles are: no
+      internal force; the root rides at their mean offset);
+    - single support: the stance leg t = 0 (the root rides with its sole), the swing leg
+      t = -e_stance: its sole travels to, and lands on, its world placement.
+
+    A leg's joints get dq = J^-1 [t, 0] (damped least squares), J [6, 6] the sole's
+    Jacobian (position and orientation, world-aligned) over its six joints at the phase's
+    last reference sample; the offsets move from the previous phase's on the minimum-jerk
+    scaling. Orientation and height are not corrected.
+    """
+
+    # Damping of the least squares, m^2 (a landing knee near full stretch, on steps, makes
+    # J nearly singular; the offsets are millimetres).
+    DAMPING = 1e-3
+
+    def __init__(self, talos, motion: Motion):
+        self.talos = talos
+        self.motion = motion
+        self.data = talos.model.createData()
+        self.legs_q = [np.asarray(leg.q_index) - 7 for leg in talos.legs]  # [6] joint indices
+        self.legs_v = [np.asarray(leg.v_index) for leg in talos.legs]  # [6] velocity indices
+        self.start = np.zeros((2, 6))  # per side: joint offset at the phase's start, rad
+        self.target = np.zeros((2, 6))  # per side: joint offset at the phase's end, rad
+
+    def begin(self, index: int, soles_xy: np.ndarray) -> None:
+        """Phase `index` starts with the soles at soles_xy [2, 2] (world, simulated)."""
+        import pinocchio as pin
+
+        phase = self.motion.phases[index]
+        offsets = np.asarray(soles_xy) - self.motion.feet[phase.start, :, :2]  # [2, 2]
+        if phase.swing < 0:
+            moves = offsets - offsets.mean(axis=0)
+        else:
+            moves = np.zeros((2, 2))
+            moves[phase.swing] = -offsets[1 - phase.swing]
+        model, data = self.talos.model, self.data
+        pin.computeJointJacobians(model, data, self.motion.q[phase.stop])
+        pin.updateFramePlacements(model, data)
+        self.start = self.target.copy()
+        for side in (0, 1):
+            frame = self.talos.sole_frame_ids[side]
+            jacobian = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:, self.legs_v[side]]
+            move = np.r_[moves[side], 0.0, 0.0, 0.0, 0.0]
+            self.target[side] = jacobian.T @ np.linalg.solve(
+                jacobian @ jacobian.T + self.DAMPING * np.eye(6), move
+            )
+
+    def offset(self, index: int, position: float) -> np.ndarray:
+        """The offset [32] (rad) added to the joint references at fractional sample `position`."""
+        from leas_jax.motion.paths import min_jerk
+
+        phase = self.motion.phases[index]
+        fraction = min(max((position - phase.start) / max(phase.stop - phase.start, 1), 0.0), 1.0)
+        s = float(min_jerk(np.array([fraction]))[0])
+        out = np.zeros(32)
+        for side in (0, 1):
+            out[self.legs_q[side]] = self.start[side] + s * (self.target[side] - self.start[side])
+        return out
 
 
 def _close_phase(result: PhaseResult, motion: Motion, index: int, data, mj) -> None:

@@ -1,0 +1,116 @@
+"""Balance margins of motions: key postures whose CoM sits at the soles' edge are reached with
+the CoM moved inside (MotionConfig.support_margin), and the tracking controller lands each
+sole on its planned world placement when the robot has crept (SimulationConfig.landing_correction)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from motion_helpers import straight_plan
+
+from leas_jax.contacts.robot.model import load_talos
+from leas_jax.motion.config import MotionConfig, SimulationConfig
+from leas_jax.motion.motion import (
+    centred_com,
+    make_motion,
+    posture_frames,
+    sole_corners,
+    support_margin,
+)
+
+
+def test_support_margin_and_centred_com_on_a_square():
+    square = np.array([[0.0, 0.0], [0.2, 0.0], [0.2, 0.2], [0.0, 0.2]])
+    assert support_margin(square, np.array([0.1, 0.1])) == pytest.approx(0.1)
+    assert support_margin(square, np.array([0.195, 0.1])) == pytest.approx(0.005)
+    assert support_margin(square, np.array([0.25, 0.1])) == pytest.approx(-0.05)
+    com = np.array([0.195, 0.15, 0.9])
+    moved = centred_com(square, com, 0.03)
+    assert support_margin(square, moved[:2]) == pytest.approx(0.03, abs=1e-6)
+    assert moved[2] == com[2]
+    # it moved along the line to the centre
+    direction = np.array([0.1, 0.1]) - com[:2]
+    step = moved[:2] - com[:2]
+    assert abs(direction[0] * step[1] - direction[1] * step[0]) < 1e-9
+    np.testing.assert_array_equal(centred_com(square, np.array([0.1, 0.1, 0.9]), 0.03), [0.1, 0.1, 0.9])
+    # a margin no point reaches: the centre
+    np.testing.assert_allclose(centred_com(square, com, 0.5)[:2], [0.1, 0.1])
+
+
+@pytest.fixture(scope="module")
+def edge_plan():
+    """A flat-ground plan whose first double-support posture after a landing has its CoM moved
+    (IK, soles and upper body kept) to 5 mm inside its soles' support polygon, at the heels."""
+    from leas_jax.motion.wbik import Targets, WholeBodyIK
+
+    plan = straight_plan(0.3)
+    talos = load_talos()
+    on = ~np.isnan(plan.feet[:, :, 0])
+    k = next(i for i in range(1, len(plan)) if on[i].all() and not on[i - 1].all())
+    feet, com, rotation = posture_frames(talos, plan.q[k])
+    corners = sole_corners(feet, on[k])
+    heel = com.copy()
+    for _ in range(300):  # walk the CoM backwards until 5 mm from the edge
+        if support_margin(corners, heel[:2] - [0.001, 0.0]) < 0.005:
+            break
+        heel[0] -= 0.001
+    ik = WholeBodyIK(talos, 50, 1e-8, 1e-9)
+    q = np.array(plan.q)
+    q[k] = ik.solve(q[k], Targets(feet, heel, rotation, q[k]))
+    assert support_margin(corners, posture_frames(talos, q[k])[1][:2]) == pytest.approx(0.005, abs=1.5e-3)
+    return dataclasses.replace(plan, q=q), k
+
+
+def test_edge_posture_is_reached_with_its_com_inside(edge_plan):
+    plan, k = edge_plan
+    talos = load_talos()
+    margin = MotionConfig().support_margin
+    motion = make_motion(plan)
+    assert motion.moved_keys.tolist() == [k]
+    reached = motion.q[motion.key_index[k]]
+    feet, com, _ = posture_frames(talos, reached)
+    on = ~np.isnan(plan.feet[k, :, 0])
+    assert support_margin(sole_corners(feet, on), com[:2]) == pytest.approx(margin, abs=1e-4)
+    # same soles, root orientation and upper body as the plan's posture; the others untouched
+    plan_feet, _, plan_rotation = posture_frames(talos, plan.q[k])
+    np.testing.assert_allclose(feet, plan_feet, atol=1e-7)
+    np.testing.assert_allclose(posture_frames(talos, reached)[2], plan_rotation, atol=1e-7)
+    others = np.delete(np.arange(len(plan)), k)
+    np.testing.assert_array_equal(motion.q[motion.key_index[others]], plan.q[others])
+    np.testing.assert_array_equal(motion.plan_q, plan.q)
+    # without the margin the plan's own posture is reached
+    plain = make_motion(plan, MotionConfig(support_margin=0.0), check=False)
+    assert plain.moved_keys.size == 0
+    np.testing.assert_array_equal(plain.q[plain.key_index], plan.q)
+
+
+def test_moved_keys_survive_save_and_load(edge_plan, tmp_path):
+    from leas_jax.motion.motion import Motion
+
+    motion = make_motion(edge_plan[0])
+    motion.save(tmp_path / "m.npz")
+    np.testing.assert_array_equal(Motion.load(tmp_path / "m.npz").moved_keys, [edge_plan[1]])
+
+
+@pytest.fixture(scope="module")
+def shifted_motion():
+    """The flat-ground motion with its planned sole placements 2 cm further along +x than where
+    the robot stands: as if it had crept 2 cm backwards before its first step."""
+    motion = make_motion(straight_plan(0.3))
+    feet, plan_feet = motion.feet.copy(), motion.plan_feet.copy()
+    feet[..., 0] += 0.02
+    plan_feet[..., 0] += 0.02
+    return dataclasses.replace(motion, feet=feet, plan_feet=plan_feet)
+
+
+def test_landing_correction_lands_on_the_world_placements(shifted_motion):
+    from leas_jax.motion.simulate import simulate
+
+    corrected = simulate(shifted_motion, config=SimulationConfig(settle=0.0))
+    plain = simulate(shifted_motion, config=SimulationConfig(settle=0.0, landing_correction=False))
+    assert not corrected.fallen and not plain.fallen
+    errors = [[p.landing_position for p in r.phases if p.kind == "land"] for r in (corrected, plain)]
+    # joint references alone land every sole 2 cm off; the correction lands both soles on theirs
+    assert min(errors[1]) > 0.017
+    assert max(errors[0][2:]) < 0.005 and max(errors[0]) < 0.012, errors[0]
+    assert corrected.success, corrected.message

@@ -193,6 +193,9 @@ def run(args) -> dict:
     if json_path.is_file() and args.scenarios:  # a run of some scenarios adds to the variant's others
         previous = json.loads(json_path.read_text())
         report["scenarios"] = {k: v for k, v in previous["scenarios"].items() if k not in names}
+        for scenario in report["scenarios"].values():  # causes as this version names them
+            for e in scenario["executions"]:
+                e["cause"] = cause(e)
     for name in names:
         plans = make_plans(name, args.starts, args.ground_starts, cache, args.checkpoint)
         if args.max_plans:

@@ -1,7 +1,7 @@
 """Execute a motion in MuJoCo physics and measure what happened, phase by phase.
 
 Host-only (MuJoCo, NumPy), not jittable. `simulate(motion, terrain)` puts Talos
-(`motion.robot.scene_model`) at the motion's first configuration and runs a joint-space
+(`motion.robot.terrain_scene`) at the motion's first configuration and runs a joint-space
 tracking controller at every physics step (1 kHz):
 
     tau = tau_ff(t) + kp (q_ref(t) - q) + kd (v_ref(t) - v),  clipped to the effort limits,
@@ -203,14 +203,13 @@ def simulate(
     import mujoco
 
     from leas_jax.contacts.robot.model import load_talos
-    from leas_jax.motion.robot import scene_model
+    from leas_jax.motion.robot import terrain_scene
     from leas_jax.terrain import loads_terrain
-    from leas_jax.terrain.export import terrain_to_mjcf
 
     started, cpu_started = clock.perf_counter(), clock.process_time()
     if terrain is None:
         terrain = loads_terrain(motion.terrain, source="<motion terrain>")
-    mj = scene_model(terrain_to_mjcf(terrain), config.timestep)
+    mj = terrain_scene(terrain, config.timestep)
     talos = load_talos()
     model = mj.model
     data = mujoco.MjData(model)

@@ -83,3 +83,20 @@ def test_weights_fitted_on_another_generator_are_named_stale():
     message = stale_weights(Path("w.npz"), {"data_key": current, "terrain": arena}, other)
     assert message.startswith("w.npz: ") and RELABEL_COMMAND in message and current[:12] in message
     assert stale_weights(Path("w.npz"), {"refreshes": "3"}) is None
+
+
+def test_the_generator_digest_reads_the_generator_and_terrain_loading_not_the_viewer(tmp_path):
+    """Editing the viewer or a terrain generator leaves the labels' key; the generator's code does not."""
+    from leas_jax.feasibility.spawns import GENERATOR_SOURCES, generator_code_digest
+
+    names = {p.name for p in GENERATOR_SOURCES}
+    assert {"planner", "robot", "model.py", "loader.py"} <= names
+    assert not names & {"contacts", "terrain", "viewer.py", "curriculum.py", "families.py"}
+    (tmp_path / "pkg").mkdir()
+    source = tmp_path / "pkg" / "model.py"
+    source.write_text("x = 1\n")
+    before = generator_code_digest((source,))
+    (tmp_path / "pkg" / "viewer.py").write_text("y = 2\n")  # beside it, not a source
+    assert generator_code_digest((source,)) == before
+    source.write_text("x = 2\n")
+    assert generator_code_digest((source,)) != before

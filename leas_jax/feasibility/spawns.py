@@ -28,17 +28,24 @@ SPAWN_MODES = ("condition", "generator")
 CHUNK = 2000  # poses per pool batch: a cache write and a progress-bar update each
 _FORMAT = "leas-verified-spawns-v1"
 _PACKAGE = Path(__file__).resolve().parent.parent
-# the code a generator verdict depends on: the generator, and the terrain's rasters and support faces
-GENERATOR_SOURCES = (_PACKAGE / "contacts", _PACKAGE / "terrain")
+# the code a generator verdict depends on: the generator and the robot model, and the terrain's
+# loading, rasters and support faces; not the viewer, the worker pools, nor the terrain
+# generators and commands, whose edits change no verdict
+GENERATOR_SOURCES = (
+    _PACKAGE / "contacts" / "planner",
+    _PACKAGE / "contacts" / "robot",
+    *(_PACKAGE / "terrain" / f"{name}.py" for name in ("loader", "mesh", "model", "sources")),
+)
 
 
 def generator_code_digest(roots=GENERATOR_SOURCES) -> str:
-    """sha256 (hex) of every .py file below `roots` (relative name and bytes), in order."""
+    """sha256 (hex) of every .py file below `roots` (folders, or .py files themselves; relative
+    name and bytes), in order."""
     digest = hashlib.sha256()
-    for root in roots:
-        root = Path(root)
-        for path in sorted(root.rglob("*.py")):
-            digest.update(f"{root.name}/{path.relative_to(root)}".encode())
+    for root in map(Path, roots):
+        base = root.parent if root.is_file() else root
+        for path in [root] if root.is_file() else sorted(root.rglob("*.py")):
+            digest.update(f"{base.name}/{path.relative_to(base)}".encode())
             digest.update(path.read_bytes())
     return digest.hexdigest()
 

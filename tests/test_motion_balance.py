@@ -114,3 +114,32 @@ def test_landing_correction_lands_on_the_world_placements(shifted_motion):
     assert min(errors[1]) > 0.017
     assert max(errors[0][2:]) < 0.005 and max(errors[0]) < 0.012, errors[0]
     assert corrected.success, corrected.message
+
+
+def test_a_crouched_stance_rises_for_a_swing_sole_behind_it():
+    """Crouched (root 0.13 m below the plan's, knees at 1.6 rad), a sole lifted 0.1 m and put
+    0.15 m back needs its ankle past its pitch limit: no lowering reaches it, a 3 cm rise does,
+    and the reaching configuration keeps its leg joints LIMIT_MARGIN inside their limits."""
+    from leas_jax.motion.motion import LIMIT_MARGIN, MAX_RISE, held_root_configuration, root_dip
+
+    talos = load_talos()
+    q = straight_plan(0.3).q[0]
+    feet, _, rotation = posture_frames(talos, q)
+    crouched = held_root_configuration(talos, q, feet, rotation, np.array([0.0, 0.0, -0.13]), np.zeros(2))
+    assert crouched is not None
+    behind = feet.copy()
+    behind[0] = feet[0].copy()
+    behind[0][0, 3] -= 0.15
+    behind[0][2, 3] += 0.10
+    zero, knees = np.zeros(2), np.zeros(2)
+    assert np.isnan(root_dip(talos, crouched, behind, rotation, zero, knees))
+    rise = root_dip(talos, crouched, behind, rotation, zero, knees, direction=-1.0, margin=LIMIT_MARGIN)
+    assert 0.0 < rise < MAX_RISE
+    risen = held_root_configuration(
+        talos, crouched, behind, rotation, np.array([0.0, 0.0, rise + 1e-6]), knees, LIMIT_MARGIN
+    )
+    assert risen is not None
+    lower = talos.model.lowerPositionLimit[talos.legs[0].q_index]
+    assert (risen[talos.legs[0].q_index] >= lower + LIMIT_MARGIN - 1e-9).all()
+    # the same rise without the margin's room is not needed: a lower one reaches
+    assert root_dip(talos, crouched, behind, rotation, zero, knees, direction=-1.0) < rise

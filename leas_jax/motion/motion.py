@@ -67,6 +67,14 @@ PHASE_KINDS = ("shift", "lift", "land")
 # contact (`single_support_coms`), found by steps of DIP_SCAN, m.
 MAX_DIP = 0.30
 DIP_SCAN = 0.01
+# ... or rises at most this far, m, where no lowering lets a leg reach its sole: crouched
+# plans (navigate's on eval_bridge, knees at 1.4-1.7 rad) lift a swing sole behind the root
+# with its ankle past its -1.31 rad pitch limit; a higher root unbends that leg.
+MAX_RISE = 0.10
+# Single-support configurations keep their leg joints this far inside their limits where
+# that works (else none), rad: the whole-body IK tracks their CoM, not their root, and ends
+# a few mrad off them (measured on eval_bridge's crouched plans: an ankle 0.1 mrad past).
+LIMIT_MARGIN = 0.03
 
 
 class MotionError(LeasError):
@@ -347,14 +355,20 @@ def _apex(terrain, start: np.ndarray, end: np.ndarray, clearance: float) -> floa
 
 
 def held_root_configuration(
-    talos, q: np.ndarray, feet: np.ndarray, rotation: np.ndarray, offset: np.ndarray, knees: np.ndarray
+    talos,
+    q: np.ndarray,
+    feet: np.ndarray,
+    rotation: np.ndarray,
+    offset: np.ndarray,
+    knees: np.ndarray,
+    margin: float = 0.0,
 ) -> np.ndarray | None:
     """q [39] with its root moved by offset [3] (world, m) and turned to rotation [3, 3]
     (world_R_base_link), both soles at feet [2, 4, 4] (world); or None.
 
     The upper body stays as in q; each leg's six joints come from the analytic leg IK
-    (`contacts.robot.ik.leg_ik_single`). None when a leg cannot reach its sole, leaves its
-    joint limits, or bends its knee less than knees [2] (rad, left and right).
+    (`contacts.robot.ik.leg_ik_single`). None when a leg cannot reach its sole, comes within
+    `margin` (rad) of its joint limits, or bends its knee less than knees [2] (rad, left and right).
     """
     from leas_jax.contacts.robot.ik import leg_ik_single
     from leas_jax.contacts.robot.model import quat_xyzw_from_matrix
@@ -370,27 +384,41 @@ def held_root_configuration(
         joints = leg_ik_single(leg, in_root[:3, :3], in_root[:3, 3])
         if joints is None or joints[3] < knees[side] - 1e-9:
             return None
+        if margin > 0.0:
+            lower = talos.model.lowerPositionLimit[leg.q_index] + margin
+            upper = talos.model.upperPositionLimit[leg.q_index] - margin
+            if ((joints < lower) | (joints > upper)).any():
+                return None
         out[leg.q_index] = joints
     return out
 
 
 def root_dip(
-    talos, q: np.ndarray, feet: np.ndarray, rotation: np.ndarray, shift: np.ndarray, knees: np.ndarray
+    talos,
+    q: np.ndarray,
+    feet: np.ndarray,
+    rotation: np.ndarray,
+    shift: np.ndarray,
+    knees: np.ndarray,
+    direction: float = 1.0,
+    margin: float = 0.0,
 ) -> float:
     """Smallest lowering (m, within 1e-7) of q's root, moved horizontally by shift [2] and turned
     to rotation [3, 3], for which `held_root_configuration` places both soles at feet [2, 4, 4];
-    NaN when none up to MAX_DIP does.
+    NaN when none up to MAX_DIP does. direction -1: the smallest rise instead, up to MAX_RISE;
+    margin: rad the leg joints keep inside their limits.
 
     The lowerings that work form an interval (the legs reach from its low end and leave
     their joint limits past its high end): a 1 cm scan finds it, bisection its low end.
     """
 
     def works(dip: float) -> bool:
-        return held_root_configuration(talos, q, feet, rotation, np.r_[shift, -dip], knees) is not None
+        offset = np.r_[shift, -direction * dip]
+        return held_root_configuration(talos, q, feet, rotation, offset, knees, margin) is not None
 
     if works(0.0):
         return 0.0
-    scan = np.arange(1, round(MAX_DIP / DIP_SCAN) + 1) * DIP_SCAN
+    scan = np.arange(1, round((MAX_DIP if direction > 0 else MAX_RISE) / DIP_SCAN) + 1) * DIP_SCAN
     found = next((d for d in scan if works(d)), None)
     if found is None:
         return float("nan")
@@ -442,8 +470,13 @@ def single_support_coms(
     first's to the last's on the minimum-jerk scaling (the root moves to make up for the
     swing leg's mass, as in double support).
 
+    Where no lowering lets both legs reach (crouched postures lift a swing sole behind the
+    root with its ankle at its pitch limit), the root rises instead, by the smallest height
+    up to MAX_RISE, on the same weight. Leg joints stay LIMIT_MARGIN inside their limits
+    where that works.
+
     Raises:
-        MotionError: the soles are out of the legs' reach even MAX_DIP lower.
+        MotionError: the soles are out of the legs' reach even MAX_DIP lower or MAX_RISE higher.
     """
     import pinocchio as pin
 
@@ -455,26 +488,45 @@ def single_support_coms(
     contact = feet[0 if lifting else -1]
     ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
     toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
-    shifts = np.zeros((len(feet), 2))
-    needs = np.array([root_dip(talos, q, *sample) for sample in zip(feet, rotations, shifts, knees)])
-    if (needs > 0.0).any():
-        shifts = config.lean * weight[:, None] * toward
-        needs = np.array([root_dip(talos, q, *sample) for sample in zip(feet, rotations, shifts, knees)])
+    for margin in (LIMIT_MARGIN, 0.0):  # joints kept inside their limits where that works
+        shifts = np.zeros((len(feet), 2))
+        needs = np.array(
+            [root_dip(talos, q, *sample, margin=margin) for sample in zip(feet, rotations, shifts, knees)]
+        )
+        if (needs > 0.0).any():
+            shifts = config.lean * weight[:, None] * toward
+            needs = np.array(
+                [root_dip(talos, q, *sample, margin=margin) for sample in zip(feet, rotations, shifts, knees)]
+            )
+        sign = 1.0
+        if np.isnan(needs).any():  # no lowering works: a rise may (crouched postures)
+            rises = np.array(
+                [
+                    root_dip(talos, q, *sample, direction=-1.0, margin=margin)
+                    for sample in zip(feet, rotations, shifts, knees)
+                ]
+            )
+            if not np.isnan(rises).any():
+                needs, sign = rises, -1.0
+        if not np.isnan(needs).any():
+            break
     if np.isnan(needs).any():
         sample = int(np.flatnonzero(np.isnan(needs))[0])
         raise MotionError(
-            f"at sample {sample} the soles are out of the legs' reach even with the root {MAX_DIP:g} m lower"
+            f"at sample {sample} the soles are out of the legs' reach even with the root {MAX_DIP:g} m "
+            f"lower or {MAX_RISE:g} m higher"
         )
-    depth = dip_depth(needs, weight)
-    if not depth <= MAX_DIP:
+    depth = sign * dip_depth(needs, weight)
+    if not -MAX_RISE <= depth <= MAX_DIP:
         raise MotionError(
-            f"the root would come down {depth:.3f} m (over {MAX_DIP:g} m) for the soles to reach"
+            f"the root would come down {depth:.3f} m (over {MAX_DIP:g} m) or rise {-depth:.3f} m "
+            f"(over {MAX_RISE:g} m) for the soles to reach"
         )
     data = talos.model.createData()
     coms = np.empty((len(feet), 3))
     for i, (f, shift) in enumerate(zip(feet, shifts)):
         offset = np.r_[shift, -depth * weight[i]]
-        configuration = held_root_configuration(talos, q, f, rotations[i], offset, knees[i])
+        configuration = held_root_configuration(talos, q, f, rotations[i], offset, knees[i], margin)
         if configuration is None:
             raise MotionError(f"at sample {i} the soles are out of the legs' reach with the root lowered")
         coms[i] = pin.centerOfMass(talos.model, data, configuration, False)

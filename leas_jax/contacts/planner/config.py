@@ -90,6 +90,15 @@ class GeneratorConfig:
     # trunk cylinder lets a guide pass a pillar or wall 0.30 m from the root
     # (test_root_steps_sideways_off_a_pillar_the_arms_meet). () never.
     arm_clearance_shifts: tuple = (0.06, 0.12)
+    # m, where a leg meets the terrain in a double-support posture with one sole more than
+    # `swing_rise` above the other and ahead of it (a foot on a riser's tread, the other on the
+    # ground before it), the root held this far back along the heading (nearest first; the
+    # usual root bounds hold): the lower leg's knee, 0.2 m ahead of its ankle, otherwise meets
+    # the edge of a riser about as high as the knee. Straight guides up 0.29-0.34 m steps
+    # stopped at the riser's foot while lower and higher ones passed
+    # (docs/results/2026-12-06-generator-steps; test_a_step_up_as_high_as_the_knee_is_climbed).
+    # () never.
+    step_up_root_shifts: tuple = (0.04, 0.08, 0.12)
     max_root_offset_z: float = 0.10  # m, root lowering when a leg is overstretched (stairs of 0.15 m rise)
     min_knee: float = (
         0.05  # rad, knee bend kept when lowering the root (away from the straight-leg singularity)
@@ -198,6 +207,9 @@ class GeneratorConfig:
         for overrides in self.retry_settings:
             self.retried(overrides)
         _check_distances("stance_shifts", self.stance_shifts, "max_root_offset_xy", self.max_root_offset_xy)
+        _check_distances(
+            "step_up_root_shifts", self.step_up_root_shifts, "max_root_offset_xy", self.max_root_offset_xy
+        )
         _check_distances(
             "arm_clearance_shifts",
             self.arm_clearance_shifts,

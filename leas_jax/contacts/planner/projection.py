@@ -4,7 +4,8 @@ The stage every other stage of the generator calls (HPP's "projection" of a stat
 its contacts): the root follows the guide (yaw and height from it, lowered by at most
 `max_root_offset_z` if a leg would be overstretched, shifted horizontally by at most
 `max_root_offset_xy`, or `max_single_support_offset_xy` on one foot, to bring the CoM
-over the support), the legs reach their soles by
+over the support, or held back along the heading where a knee meets a riser it steps up,
+`step_up_root_shifts`), the legs reach their soles by
 analytic IK within the joint limits, the upper body holds the first of
 `GeneratorConfig.upper_bodies` whose arms miss the terrain, and the posture must be free
 of terrain and self collision (coal) and in static equilibrium (hpp-centroidal-dynamics
@@ -151,6 +152,7 @@ class PostureProjection:
         # Each upper body is a fallback for the one before: tried only where an arm or gripper
         # of that one met the terrain (another moves only the arms: any other check fails the
         # same way). Where the first succeeds the posture is the one it alone would give.
+        legs_hit = False
         for upper in self.config.upper_bodies:
             arms_hit = False
             for offset in offsets:
@@ -160,8 +162,11 @@ class PostureProjection:
                     )
                     if built is not None:
                         return built
-                    arms_hit |= hit
+                    arms_hit |= hit == "arm"
+                    legs_hit |= hit == "leg"
             if not arms_hit:
+                if legs_hit and air is None:
+                    return self._held_back(guide_pose, guide_index, root_R, guide_xy, target, contacts, upper)
                 return None
         # The last upper body's arm still meets the terrain: the root steps sideways off the
         # guide, to either side (`arm_clearance_shifts`, within the usual root bounds).
@@ -174,13 +179,45 @@ class PostureProjection:
                     return built
         return None
 
+    def _held_back(self, guide_pose, guide_index, root_R, guide_xy, target, contacts, upper):
+        """A stepping-up double-support posture with the root held back along the heading by
+        each of `step_up_root_shifts` in turn (nearest first; within `max_root_offset_xy`), or
+        None. Only where one sole is more than `swing_rise` above the other and ahead of it
+        along the heading (a foot on a riser's tread, the other on the ground before it), after
+        a leg met the terrain at the root's usual places (`posture`).
+
+        Talos's knees bend forward: with the root 1 m over the ground and the hip over or ahead
+        of the ankle, the knee joint is 0.16-0.2 m ahead of the hip and about 0.4 m up, the
+        thigh's mesh down to 0.28 m. With the lower sole near a riser's foot and the root over
+        the support, that mesh meets the edge of a riser about as high, and straight guides up
+        0.29-0.34 m steps stopped there while lower and higher ones passed
+        (docs/results/2026-12-06-generator-steps). The root held back over the lower sole, as a
+        person's hips stay back until the weight goes onto the upper foot, takes the knee back
+        with it."""
+        cfg = self.config
+        if len(contacts) != 2:
+            return None
+        (_, low, _), (_, high, _) = sorted(contacts, key=lambda contact: float(contact[1][2]))
+        heading = root_R[:2, 0]
+        if float(high[2] - low[2]) <= cfg.swing_rise or float((high[:2] - low[:2]) @ heading) <= 0.0:
+            return None  # soles level, or the higher one behind: no riser ahead of the lower one
+        back = -heading
+        for distance in cfg.step_up_root_shifts:
+            built, _ = self._build(
+                guide_pose, guide_index, root_R, guide_xy, distance * back, target, contacts, None, upper
+            )
+            if built is not None:
+                return built
+        return None
+
     def _build(self, guide_pose, guide_index, root_R, guide_xy, offset, target, contacts, air, upper):
         """One root offset (None: shift the CoM onto `target`), one placement of the foot in
         the air (None, or (side, pos [3], rot [3, 3], follows_root), see `posture`) and one
         upper-body posture (a key of `talos.upper_refs`); all checks.
 
         Returns:
-            (the posture or None, whether it failed because an arm or gripper met the terrain)."""
+            (the posture or None, the part of Talos that met the terrain where that is why it
+            failed ("arm", "leg", "trunk"; `robot.collision.body_part`), else None)."""
         cfg = self.config
         talos = self.talos
         iterations = 1 if offset is not None else 3
@@ -194,12 +231,12 @@ class PostureProjection:
             z = self.root_height(guide_pose, root_xy, root_R, contacts)
             if z is None:
                 self.count_rejection("root height")
-                return None, False
+                return None, None
             root_p = np.array([root_xy[0], root_xy[1], z])
             leg_q = self.legs_ik(root_R, root_p, contacts)
             if leg_q is None:
                 self.count_rejection("leg IK")
-                return None, False
+                return None, None
             if air is not None:
                 side, pos, rot, follows_root = air
                 if follows_root:
@@ -207,7 +244,7 @@ class PostureProjection:
                 solved = self.legs_ik(root_R, root_p, [(side, pos, rot)])
                 if solved is None:
                     self.count_rejection("leg IK")
-                    return None, False
+                    return None, None
                 leg_q[side] = solved[side]
             q = talos.configuration(root_p, root_R, leg_q, upper)
             com = talos.com(q)
@@ -227,7 +264,7 @@ class PostureProjection:
                 # projection), the LP's robustness is < 0; rejected without the LP.
                 if -math.inf < margin < -_OUTSIDE_MARGIN and cfg.min_robustness >= 0.0:
                     self.count_rejection("equilibrium")
-                    return None, False
+                    return None, None
             # Every check must pass, so their order changes no result: cheapest first
             # (terrain collision ~50 us, the LP ~300 us, self-collision ~100 us and rarely failing).
             rot, pos = self.robot.placements_fast(talos, root_R, root_p, leg_q, upper)
@@ -235,18 +272,18 @@ class PostureProjection:
             hits = self.robot.terrain_contacts(rot, pos, self.terrain_objects, aabb=aabb)
             if hits:
                 self.count_rejection("terrain collision", hits[0][0])
-                return None, self.robot.parts[hits[0][0]] == "arm"
+                return None, self.robot.parts[hits[0][0]]
             if margin < cfg.flat_com_margin:
                 self.equilibrium.set_contacts(points, normals)
                 if self.equilibrium.robustness(com) < cfg.min_robustness:
                     self.count_rejection("equilibrium")
-                    return None, False
+                    return None, None
             pairs = self.robot.self_contacts(rot, pos, aabb=aabb)
             if pairs:
                 self.count_rejection("self collision", pairs[0][1])
-                return None, False
+                return None, None
             feet = np.full((2, 7), np.nan)  # built for an accepted posture only
             for side, sole_pos, sole_rot in contacts:
                 feet[side] = placement_row(sole_pos, sole_rot)
-            return ContactPosture(q=q, feet=feet, guide_index=guide_index), False
-        return None, False
+            return ContactPosture(q=q, feet=feet, guide_index=guide_index), None
+        return None, None

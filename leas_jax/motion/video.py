@@ -88,9 +88,9 @@ def render_frames(
     motion,
     q: np.ndarray,
     size: tuple[int, int] = (320, 240),
-    distance: float = 3.2,
-    azimuth: float = 135.0,
-    elevation: float = -15.0,
+    distance: float = 3.5,
+    azimuth: float = 60.0,
+    elevation: float = -12.0,
 ) -> list[np.ndarray]:
     """RGB frames [H, W, 3] uint8 of Talos at configurations q [F, 39] (Pinocchio order, world)
     in the motion's terrain, the camera following the root (`distance` m away, `azimuth` and

@@ -49,7 +49,15 @@ ROOT = Path(__file__).resolve().parents[1]
 # The target group (90 %): Table II's flat ground, eval_stairs, eval_bridge and two HPP demos.
 TARGET = ("ground", "stairs", "bridge", "hpp_talos_stairs10", "hpp_talos_navBauzil")
 # The other evaluation scenarios and HPP scenes (75 % over all scenes with a verified plan).
-OTHERS = ("hole", "stairs_side", "hpp_stairs", "hpp_bridge", "hpp_hole", "hpp_talos_flatGround")
+OTHERS = (
+    "hole",
+    "stairs_side",
+    "hpp_stairs",
+    "hpp_bridge",
+    "hpp_hole",
+    "hpp_talos_flatGround",
+    "hpp_talos_stairs15",
+)
 # Steering method per scenario (default rblin): navigate where RBLin's straight lines meet
 # no verified plan (eval_bridge: 0 of 4 starts; the Bauzil room's demo query).
 METHODS = {
@@ -64,6 +72,7 @@ HPP_FILES = {
     "hpp_talos_stairs10": "terrains/hpp/demos/talos_stairs10.toml",
     "hpp_talos_navBauzil": "terrains/hpp/demos/talos_navBauzil.toml",
     "hpp_talos_flatGround": "terrains/hpp/demos/talos_flatGround.toml",
+    "hpp_talos_stairs15": "terrains/hpp/demos/talos_stairs15.toml",
     "hpp_stairs": "terrains/hpp/stairs.toml",
     "hpp_bridge": "terrains/hpp/bridge.toml",
     "hpp_hole": "terrains/hpp/hole.toml",
@@ -187,6 +196,7 @@ def run(args) -> dict:
         "simulation_config": json.loads(args.simulation_config),
         "starts": args.starts,
         "ground_starts_per_cell": args.ground_starts,
+        "max_plans": args.max_plans,
         "scenarios": {},
     }
     json_path = out / f"motion_execution_{args.variant}.json"
@@ -220,6 +230,24 @@ def run(args) -> dict:
         }
         report["summary"] = summarise(report["scenarios"])
         json_path.write_text(json.dumps(report, indent=1))
+    (out / f"motion_execution_{args.variant}.md").write_text(markdown(report))
+    return report
+
+
+def combine(args) -> dict:
+    """Merge the scenarios of the variants named by --combine (later ones win) into --variant's
+    JSON and markdown; the first variant's settings are kept, the others' noted."""
+    out = Path(args.out)
+    reports = [json.loads((out / f"motion_execution_{v}.json").read_text()) for v in args.combine.split(",")]
+    report = dict(reports[0], variant=args.variant, combined_from=args.combine.split(","))
+    report["scenarios"] = {}
+    for part in reports:
+        report["scenarios"].update(part["scenarios"])
+    for scenario in report["scenarios"].values():
+        for e in scenario["executions"]:
+            e["cause"] = cause(e)
+    report["summary"] = summarise(report["scenarios"])
+    (out / f"motion_execution_{args.variant}.json").write_text(json.dumps(report, indent=1))
     (out / f"motion_execution_{args.variant}.md").write_text(markdown(report))
     return report
 
@@ -293,7 +321,14 @@ def markdown(report: dict) -> str:
         f"# Motion execution: variant `{report['variant']}`",
         "",
         f"MotionConfig overrides: `{json.dumps(report['motion_config'])}`; SimulationConfig overrides: "
-        f"`{json.dumps(report['simulation_config'])}`. Plans of each scenario's method: {report['starts']} start(s) per scenario, {report['ground_starts_per_cell']} per cell of ground's nine.",
+        f"`{json.dumps(report['simulation_config'])}`. Plans of each scenario's method: {report['starts']} start(s) per scenario, {report['ground_starts_per_cell']} per cell of ground's nine"
+        + (f"; at most {report['max_plans']} executed per scenario" if report.get("max_plans") else "")
+        + (
+            f"; merged from the variants {', '.join(report['combined_from'])}"
+            if report.get("combined_from")
+            else ""
+        )
+        + ". Rates: executed (no fall, every phase passes) over verified plans executed.",
         "",
         "| scenario | method | starts | verified plans | executed (95 % Wilson) | made, no fall | failures by cause |",
         "|---|---|---|---|---|---|---|",
@@ -350,10 +385,15 @@ def main(argv=None) -> int:
         "--max-plans", type=int, default=0, help="execute at most this many plans per scenario"
     )
     parser.add_argument("--variant", default="current", help="name of this configuration in the output files")
+    parser.add_argument(
+        "--combine",
+        default=None,
+        help="comma-separated variants whose JSON files in --out are merged into --variant's (nothing run)",
+    )
     parser.add_argument("--motion-config", default="{}", help="JSON of MotionConfig overrides")
     parser.add_argument("--simulation-config", default="{}", help="JSON of SimulationConfig overrides")
     args = parser.parse_args(argv)
-    report = run(args)
+    report = combine(args) if args.combine else run(args)
     print(markdown(report))
     return 0
 

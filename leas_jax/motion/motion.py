@@ -488,7 +488,11 @@ def single_support_coms(
     contact = feet[0 if lifting else -1]
     ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
     toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
-    for margin in (LIMIT_MARGIN, 0.0):  # joints kept inside their limits where that works
+    data = talos.model.createData()
+
+    def attempt(margin: float) -> np.ndarray:
+        """CoMs [M, 3] of the held-root configurations with leg joints `margin` rad inside their
+        limits (MotionError: none)."""
         shifts = np.zeros((len(feet), 2))
         needs = np.array(
             [root_dip(talos, q, *sample, margin=margin) for sample in zip(feet, rotations, shifts, knees)]
@@ -506,30 +510,32 @@ def single_support_coms(
                     for sample in zip(feet, rotations, shifts, knees)
                 ]
             )
-            if not np.isnan(rises).any():
-                needs, sign = rises, -1.0
-        if not np.isnan(needs).any():
-            break
-    if np.isnan(needs).any():
-        sample = int(np.flatnonzero(np.isnan(needs))[0])
-        raise MotionError(
-            f"at sample {sample} the soles are out of the legs' reach even with the root {MAX_DIP:g} m "
-            f"lower or {MAX_RISE:g} m higher"
-        )
-    depth = sign * dip_depth(needs, weight)
-    if not -MAX_RISE <= depth <= MAX_DIP:
-        raise MotionError(
-            f"the root would come down {depth:.3f} m (over {MAX_DIP:g} m) or rise {-depth:.3f} m "
-            f"(over {MAX_RISE:g} m) for the soles to reach"
-        )
-    data = talos.model.createData()
-    coms = np.empty((len(feet), 3))
-    for i, (f, shift) in enumerate(zip(feet, shifts)):
-        offset = np.r_[shift, -depth * weight[i]]
-        configuration = held_root_configuration(talos, q, f, rotations[i], offset, knees[i], margin)
-        if configuration is None:
-            raise MotionError(f"at sample {i} the soles are out of the legs' reach with the root lowered")
-        coms[i] = pin.centerOfMass(talos.model, data, configuration, False)
+            if np.isnan(rises).any():
+                sample = int(np.flatnonzero(np.isnan(needs))[0])
+                raise MotionError(
+                    f"at sample {sample} the soles are out of the legs' reach even with the root {MAX_DIP:g} m "
+                    f"lower or {MAX_RISE:g} m higher"
+                )
+            needs, sign = rises, -1.0
+        depth = sign * dip_depth(needs, weight)
+        if not -MAX_RISE <= depth <= MAX_DIP:
+            raise MotionError(
+                f"the root would come down {depth:.3f} m (over {MAX_DIP:g} m) or rise {-depth:.3f} m "
+                f"(over {MAX_RISE:g} m) for the soles to reach"
+            )
+        coms = np.empty((len(feet), 3))
+        for i, (f, shift) in enumerate(zip(feet, shifts)):
+            offset = np.r_[shift, -depth * weight[i]]
+            configuration = held_root_configuration(talos, q, f, rotations[i], offset, knees[i], margin)
+            if configuration is None:
+                raise MotionError(f"at sample {i} the soles are out of the legs' reach with the root lowered")
+            coms[i] = pin.centerOfMass(talos.model, data, configuration, False)
+        return coms
+
+    try:  # leg joints kept LIMIT_MARGIN inside their limits where that works
+        coms = attempt(LIMIT_MARGIN)
+    except MotionError:
+        coms = attempt(0.0)
     coms[:, :2] = lerp(coms[0, :2], coms[-1, :2], min_jerk(np.arange(len(feet)) / (len(feet) - 1)))
     return coms
 

@@ -11,12 +11,14 @@ half-sitting place (leg IK within the joint limits), the kinematic bound of step
 
     python studies/generator_steps.py --label after [--out DIR]
     python studies/generator_steps.py --compare before after [--out DIR]
+    python studies/generator_steps.py --rough BEFORE.json AFTER.json [--out DIR]
 
 The first writes generator_steps_<label>.json (every case: coverage, where and why it
 stops, verification, seconds; the provenance of `leas_jax` as imported: run it with another
 checkout first on PYTHONPATH to measure that one); the second reads two of them and writes
 generator_steps.md (per feature the sizes covered in each, then every case whose coverage
-differs or that is not covered after).
+differs or that is not covered after); the third compares two runs of
+studies/generator_rough_scenes.py per scene (rough_scenes.json / .md).
 """
 
 from __future__ import annotations
@@ -247,11 +249,51 @@ def compare(before: dict, after: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def rough_compare(before_path: Path, after_path: Path) -> tuple[dict, str]:
+    """Per HPP rough scene, the straight guides of studies/generator_rough_scenes.py covered
+    and their mean coverage in two of its JSON outputs, and the guides whose coverage fell or
+    rose: (summary, markdown)."""
+    before, after = (json.loads(Path(path).read_text()) for path in (before_path, after_path))
+    old = {scene["name"]: scene["guides"] for scene in before["scenes"]}
+    summary = []
+    for scene in after["scenes"]:
+        was, now = old[scene["name"]], scene["guides"]
+        pairs = list(zip(was, now, strict=True))
+        summary.append(
+            {
+                "scene": scene["name"],
+                "guides": len(now),
+                "covered_before": sum(g["covered"] for g in was),
+                "covered_after": sum(g["covered"] for g in now),
+                "mean_coverage_before": round(float(np.mean([g["coverage"] for g in was])), 4),
+                "mean_coverage_after": round(float(np.mean([g["coverage"] for g in now])), 4),
+                "fell": sum(b["coverage"] > a["coverage"] + 1e-9 for b, a in pairs),
+                "rose": sum(a["coverage"] > b["coverage"] + 1e-9 for b, a in pairs),
+            }
+        )
+    lines = [
+        "| scene | guides | covered before | covered after | mean coverage before % | after % | guides lower / higher after |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for row in summary:
+        lines.append(
+            f"| {row['scene']} | {row['guides']} | {row['covered_before']} | {row['covered_after']} | "
+            f"{100 * row['mean_coverage_before']:.1f} | {100 * row['mean_coverage_after']:.1f} | {row['fell']} / {row['rose']} |"
+        )
+    return {"scenes": summary}, "\n".join(lines) + "\n"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--label", help="run every case; write generator_steps_<label>.json")
     parser.add_argument(
         "--compare", nargs=2, metavar=("BEFORE", "AFTER"), help="labels of two runs to compare"
+    )
+    parser.add_argument(
+        "--rough",
+        nargs=2,
+        metavar=("BEFORE_JSON", "AFTER_JSON"),
+        help="two generator_rough_scenes.json: write rough_scenes.json / .md (per scene, before and after)",
     )
     parser.add_argument("--out", default=OUT)
     args = parser.parse_args()
@@ -280,6 +322,11 @@ def main() -> None:
         )
         text = compare(before, after)
         (out / "generator_steps.md").write_text(text)
+        print(text, end="")
+    if args.rough:
+        summary, text = rough_compare(*args.rough)
+        (out / "rough_scenes.json").write_text(json.dumps(summary, indent=1) + "\n")
+        (out / "rough_scenes.md").write_text(text)
         print(text, end="")
 
 

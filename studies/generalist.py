@@ -16,7 +16,9 @@ Each policy is measured
         --policy generalist=RUN_DIR --out docs/results/2026-12-06-generalist
 
 writes `generalist.json`, `generalist.md` and `generalist.png` into `--out` (resumable: a
-finished (policy, arena, seed) or (policy, scenario) is read back from the JSON).
+finished (policy, arena, seed) or (policy, scenario) is read back from the JSON);
+`--training-curves RUN_DIR` also draws a curriculum run's learning curves (mean row, episodes
+ending invalid, episode length and return) into `training_<run name>.png`.
 """
 
 from __future__ import annotations
@@ -178,6 +180,21 @@ def plot(results: dict, path: Path) -> None:
     plt.close(figure)
 
 
+TRAINING_PANELS = [
+    ("curriculum_level", "mean curriculum row"),
+    ("invalid_fraction", "episodes ending invalid (fraction)"),
+    ("episode_length", "episode length (steps)"),
+    ("episode_return", "episode return"),
+]
+
+
+def plot_training(run_dir: Path, path: Path) -> None:
+    """Learning curves of a curriculum run (its metrics.jsonl)."""
+    from leas_jax.eval.report import plot_curves, read_metrics
+
+    plot_curves(read_metrics(run_dir), TRAINING_PANELS, path)
+
+
 def _machine() -> dict:
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
     return {
@@ -199,6 +216,7 @@ def main() -> None:
     parser.add_argument("--n-starts", type=int, default=20, help="starts per scenario cell")
     parser.add_argument("--no-scenarios", action="store_true")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--training-curves", action="append", default=[], metavar="RUN_DIR")
     args = parser.parse_args()
 
     from leas_jax.training.policy import load_policy
@@ -206,7 +224,9 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     store = out / "generalist.json"
-    results = json.loads(store.read_text()) if store.exists() else {"policies": {}, "arenas": {}, "scenarios": {}}
+    results = (
+        json.loads(store.read_text()) if store.exists() else {"policies": {}, "arenas": {}, "scenarios": {}}
+    )
 
     def save():
         results["machine"] = _machine()
@@ -216,6 +236,8 @@ def main() -> None:
         (out / "generalist.md").write_text(markdown(results))
         plot(results, out / "generalist.png")
 
+    for run_dir in args.training_curves:
+        plot_training(Path(run_dir), out / f"training_{Path(run_dir).name}.png")
     seeds = [int(s) for s in args.seeds.split(",")]
     for item in args.policy:
         label, _, run_dir = item.partition("=")
@@ -227,7 +249,9 @@ def main() -> None:
                 if str(seed) in done:
                     continue
                 began = time.perf_counter()
-                row = arena_row(policy, _arena_path(arena, out), seed, args.episodes, args.guides, args.workers)
+                row = arena_row(
+                    policy, _arena_path(arena, out), seed, args.episodes, args.guides, args.workers
+                )
                 done[str(seed)] = row
                 save()
                 print(

@@ -149,6 +149,7 @@ def cause(summary: dict) -> str:
         for key, label in (
             ("equilibrium", "equilibrium"),
             ("out of the legs' reach", "soles out of reach"),
+            ("for the soles to reach", "soles out of reach"),
             ("torque", "torque"),
             ("velocity", "velocity"),
             ("joint limit", "joint limit"),

@@ -22,47 +22,40 @@ class VideoError(LeasError):
     """No frame can be rendered (no OpenGL backend) or the file type is not supported."""
 
 
-def _gl_context_works() -> bool:
-    """Whether `mujoco.Renderer` can render one frame of a one-sphere model."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_string(
-        '<mujoco><worldbody><geom type="sphere" size=".1"/></worldbody></mujoco>'
-    )
-    try:
-        renderer = mujoco.Renderer(model, 8, 8)
-        renderer.update_scene(mujoco.MjData(model))
-        renderer.render()
-        renderer.close()
-    except Exception:  # noqa: BLE001 - any GL failure means: this backend cannot render
-        return False
-    return True
+# One frame of a one-sphere model: exit 0 when the backend in MUJOCO_GL renders.
+_PROBE = (
+    "import mujoco; m = mujoco.MjModel.from_xml_string("
+    '\'<mujoco><worldbody><geom type="sphere" size=".1"/></worldbody></mujoco>\'); '
+    "r = mujoco.Renderer(m, 8, 8); r.update_scene(mujoco.MjData(m)); r.render(); r.close()"
+)
 
 
 def ensure_gl() -> str:
-    """The OpenGL backend MuJoCo renders with (MUJOCO_GL, else the first of GL_BACKENDS that works).
+    """The OpenGL backend MuJoCo renders with: MUJOCO_GL when set, else the first of
+    GL_BACKENDS that renders a frame.
 
-    MUJOCO_GL must be set before `mujoco` is first imported for it to take effect; this
-    sets it when unset and `mujoco` is not yet imported.
+    Each backend is tried in a child process: MuJoCo picks its backend when first imported,
+    and a backend that cannot open a context may abort the process (GLFW without a display).
 
     Raises:
         VideoError: no backend renders.
     """
+    import subprocess
     import sys
 
     chosen = os.environ.get("MUJOCO_GL")
-    if chosen is None and "mujoco" not in sys.modules:
-        for backend in GL_BACKENDS:
-            os.environ["MUJOCO_GL"] = backend
-            try:
-                if _gl_context_works():
-                    return backend
-            except Exception:  # noqa: BLE001 - an import-time GL failure: try the next one
-                pass
-            sys.modules.pop("mujoco", None)
-        os.environ.pop("MUJOCO_GL", None)
-    elif _gl_context_works():
-        return chosen or "default"
+    for backend in (chosen,) if chosen else GL_BACKENDS:
+        try:
+            done = subprocess.run(
+                [sys.executable, "-c", _PROBE],
+                env=dict(os.environ, MUJOCO_GL=backend),
+                capture_output=True,
+                timeout=120,
+            )
+        except (OSError, subprocess.TimeoutExpired):
+            continue
+        if done.returncode == 0:
+            return backend
     raise VideoError(
         "no OpenGL backend renders offscreen (MUJOCO_GL=egl needs libegl1, osmesa needs libosmesa6: "
         "apt-get install -y libegl1 libosmesa6)"
@@ -96,17 +89,40 @@ def render_frames(
     in the motion's terrain, the camera following the root (`distance` m away, `azimuth` and
     `elevation` in deg, MuJoCo's free camera).
 
+    Rendered in a child process whose MUJOCO_GL is `ensure_gl`'s backend (this process may
+    have imported MuJoCo with another one).
+
     Raises:
         VideoError: no OpenGL backend.
     """
-    ensure_gl()
+    import concurrent.futures
+    import multiprocessing
+
+    backend = ensure_gl()
+    previous = os.environ.get("MUJOCO_GL")
+    os.environ["MUJOCO_GL"] = backend  # inherited by the spawned child
+    try:
+        context = multiprocessing.get_context("spawn")
+        with concurrent.futures.ProcessPoolExecutor(1, context) as pool:
+            return pool.submit(
+                _render_here, motion.terrain, np.asarray(q), size, distance, azimuth, elevation
+            ).result()
+    finally:
+        if previous is None:
+            os.environ.pop("MUJOCO_GL", None)
+        else:
+            os.environ["MUJOCO_GL"] = previous
+
+
+def _render_here(terrain_text: str, q: np.ndarray, size, distance: float, azimuth: float, elevation: float):
+    """`render_frames` in this process (MuJoCo's backend already chosen)."""
     import mujoco
 
     from leas_jax.motion.robot import scene_model
     from leas_jax.terrain import loads_terrain
     from leas_jax.terrain.export import terrain_to_mjcf
 
-    terrain = loads_terrain(motion.terrain, source="<motion terrain>")
+    terrain = loads_terrain(terrain_text, source="<motion terrain>")
     mj = scene_model(terrain_to_mjcf(terrain), 0.001)
     model = mj.model
     width, height = size

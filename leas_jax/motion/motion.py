@@ -70,7 +70,7 @@ DIP_SCAN = 0.01
 # ... or rises at most this far, m, where no lowering lets a leg reach its sole: crouched
 # plans (navigate's on eval_bridge, knees at 1.4-1.7 rad) lift a swing sole behind the root
 # with its ankle past its -1.31 rad pitch limit; a higher root unbends that leg.
-MAX_RISE = 0.10
+MAX_RISE = 0.15
 # Single-support configurations keep their leg joints this far inside their limits where
 # that works (else none), rad: the whole-body IK tracks their CoM, not their root, and ends
 # a few mrad off them (measured on eval_bridge's crouched plans: an ankle 0.1 mrad past).
@@ -472,8 +472,10 @@ def single_support_coms(
 
     Where no lowering lets both legs reach (crouched postures lift a swing sole behind the
     root with its ankle at its pitch limit), the root rises instead, by the smallest height
-    up to MAX_RISE, on the same weight. Leg joints stay LIMIT_MARGIN inside their limits
-    where that works.
+    up to MAX_RISE, on the same weight, and the CoM follows those configurations' own
+    (no blend: the whole-body IK then reproduces their roots, whose ankles keep their margin;
+    measured on eval_bridge, the blend put an ankle past its limit). Leg joints stay
+    LIMIT_MARGIN inside their limits where that works.
 
     Raises:
         MotionError: the soles are out of the legs' reach even MAX_DIP lower or MAX_RISE higher.
@@ -530,14 +532,14 @@ def single_support_coms(
             if configuration is None:
                 raise MotionError(f"at sample {i} the soles are out of the legs' reach with the root lowered")
             coms[i] = pin.centerOfMass(talos.model, data, configuration, False)
+        if sign > 0:
+            coms[:, :2] = lerp(coms[0, :2], coms[-1, :2], min_jerk(np.arange(len(feet)) / (len(feet) - 1)))
         return coms
 
     try:  # leg joints kept LIMIT_MARGIN inside their limits where that works
-        coms = attempt(LIMIT_MARGIN)
+        return attempt(LIMIT_MARGIN)
     except MotionError:
-        coms = attempt(0.0)
-    coms[:, :2] = lerp(coms[0, :2], coms[-1, :2], min_jerk(np.arange(len(feet)) / (len(feet) - 1)))
-    return coms
+        return attempt(0.0)
 
 
 def support_margin(points: np.ndarray, point: np.ndarray) -> float:

@@ -182,7 +182,11 @@ def register(subparsers) -> None:
         ),
     )
     sim.add_argument("motion", metavar="MOTION", help="motion file (.npz, `leas motion`)")
-    sim.add_argument("--html", default=None, help="also write a 3D view that plays the planned motion (ghost) and the simulated rollout")
+    sim.add_argument(
+        "--html",
+        default=None,
+        help="also write a 3D view that plays the planned motion (ghost) and the simulated rollout",
+    )
     sim.add_argument(
         "--video",
         default=None,

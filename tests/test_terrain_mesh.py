@@ -69,7 +69,7 @@ def test_round_trip_raster_and_surfaces(path, tmp_path):
     mesh = _twin(boxes, tmp_path)
     a, b = boxes.raster(), mesh.raster()
     keep = _away_from_edges(a)
-    assert keep.mean() > 0.9
+    assert keep.mean() > 0.85  # the curriculum arena's rubble and blocks put 10 % of its cells on edges
     np.testing.assert_allclose(b[keep], a[keep], atol=1e-3, rtol=0)
     area_boxes = sum(map(_area, boxes.support_surfaces()))
     area_mesh = sum(map(_area, mesh.support_surfaces()))

@@ -1,5 +1,9 @@
-"""Contact generator on one step up: a riser about as high as Talos's knee is climbed by holding
-the root back over the lower sole (`GeneratorConfig.step_up_root_shifts`)."""
+"""Contact generator at the limits of rough ground: a riser about as high as Talos's knee is
+climbed by holding the root back over the lower sole (`GeneratorConfig.step_up_root_shifts`);
+a field of debris tiles narrower than a turned sole is crossed by turning the soles to fit
+(`GeneratorConfig.sole_turns`)."""
+
+import math
 
 import numpy as np
 import pytest
@@ -82,3 +86,48 @@ def test_the_root_is_held_back_only_for_a_sole_above_and_ahead_of_the_other():
 def test_held_back_distances_stay_within_the_root_bound():
     with pytest.raises(ValueError, match="step_up_root_shifts"):
         GeneratorConfig(step_up_root_shifts=(0.2,))
+
+
+def debris_terrain(tilt_deg: float = 15.0):
+    """Flat ground, then 5 columns of 0.29 x 0.19 m debris tiles (x 1.5-3.0 m, their tops about
+    z = 0) each tilted by `tilt_deg` about x or y in turn, then flat ground (5 x 4 m): the
+    tiles of hpp-environments' slalom_debris, which hold the 0.20 x 0.13 m sole only within
+    0.28 rad of one of their axes."""
+    tilt = math.radians(tilt_deg)
+    text = 'name = "debris"\nbounds = [[0.0, 0.0], [5.0, 4.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
+    text += "[[box]]\ncenter = [0.75, 2.0, -0.25]\nsize = [1.5, 4.0, 0.5]\n"
+    text += "[[box]]\ncenter = [4.0, 2.0, -0.25]\nsize = [2.0, 4.0, 0.5]\n"
+    for i, x in enumerate(np.arange(1.65, 3.0, 0.3)):
+        for j, y in enumerate(np.arange(0.1, 4.0, 0.2)):
+            roll, pitch = [(tilt, 0.0), (-tilt, 0.0), (0.0, tilt), (0.0, -tilt)][(i + 2 * j) % 4]
+            text += f"[[box]]\ncenter = [{x:.3f}, {y:.3f}, -0.05]\nsize = [0.29, 0.19, 0.1]\nrpy = [{roll}, {pitch}, 0.0]\n"
+    return loads_terrain(text)
+
+
+def diagonal_guide(yaw: float, length: float = 3.0) -> np.ndarray:
+    """[T, 4] straight guide from (0.8, 1.2) at heading `yaw` over the debris, root ROOT high."""
+    count = int(length / (SPEED * DT)) + 1
+    along = np.linspace(0.0, length, count)
+    x, y = 0.8 + along * math.cos(yaw), 1.2 + along * math.sin(yaw)
+    return np.stack([x, y, np.full(count, ROOT), np.full(count, yaw)], axis=1)
+
+
+def test_a_sole_turns_to_fit_a_small_tile():
+    """Crossed at 0.4 rad to the tiles' axes, no tile holds a sole at the guide's yaw: without
+    turns both feet stay on the ground before the tiles, the root walks on beyond them and the
+    plan stops (feet lagging, CoM out of the support); with them the soles turn to each tile's
+    axis and the whole guide is covered and verified."""
+    terrain, guide = debris_terrain(), diagonal_guide(0.4)
+    stuck, reasons = ContactGenerator(terrain, GeneratorConfig(sole_turns=())).stop_reasons(guide, DT)
+    assert stuck.coverage < 0.5
+    assert np.nanmax(stuck.feet[:, :, 0]) < 1.5  # no sole on a tile
+    assert reasons["no foothold"] + reasons["equilibrium"] > 0
+    plan = ContactGenerator(terrain).plan(guide, DT)
+    assert plan.coverage == 1.0
+    assert verify(plan).ok
+    on_tiles = (plan.feet[:, :, 0] > 1.5) & (plan.feet[:, :, 0] < 3.0)
+    quat = plan.feet[on_tiles][:, 3:]
+    sole_yaw = np.arctan2(
+        2 * (quat[:, 3] * quat[:, 2] + quat[:, 0] * quat[:, 1]), 1 - 2 * (quat[:, 1] ** 2 + quat[:, 2] ** 2)
+    )
+    assert len(sole_yaw) > 0 and np.all(np.abs(sole_yaw - 0.4) > 0.05)  # turned off the guide's yaw

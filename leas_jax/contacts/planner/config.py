@@ -120,6 +120,13 @@ class GeneratorConfig:
     beam_align_yaw: float = (
         0.35  # rad, the hip-yaw joint's inward limit (max_foot_yaw is 0.5); 0 disables (lanes too)
     )
+    # rad, turns of a sole off the step's yaw tried, smallest first and each way, on a face that
+    # holds no candidate sole at the step's yaw (nor at a beam's axis): a 0.30 x 0.20 m debris
+    # tile holds the 0.20 x 0.13 m sole only within 20 degrees of one of its axes, and a guide
+    # crossing a field of them at 40 degrees (slalom_debris) left both feet on the ground
+    # before it (test_a_sole_turns_to_fit_a_small_tile). Up to `max_foot_yaw`; the leg's IK
+    # then bounds the turn by its hip-yaw joint (0.35 rad inward). () never.
+    sole_turns: tuple = tuple(round(0.05 * k, 2) for k in range(1, 11))
     beam_drop: float = 0.05  # m, a beam's lanes need terrain this much lower this far beyond both its edges
     # m, sole rectangle kept this far inside the face polygon (docs/design.md §6's 5 mm tolerance). Two
     # soles side by side take 2 x 0.13 + feet_gap + 2 x edge_margin, which must fit eval_bridge's

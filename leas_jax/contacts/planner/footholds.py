@@ -158,6 +158,8 @@ class Footholds:
             # on the face (reachability is re-checked exactly by IK below).
             world[:, 2] = surfaces.plane_height(s, world[:, :2])
             grouped = len(surfaces.members[surfaces.group[s]]) > 1
+            if not grouped:
+                yaws = yaws + self._turned_yaws(s, world, normal, yaws, target_yaw, done)
             for yaw in yaws:
                 rot = sole_rotation_single(normal, yaw)
                 inside = self._inside_face(s, world, rot)
@@ -309,6 +311,29 @@ class Footholds:
         if 1e-3 < abs(best) <= self.config.beam_align_yaw:
             return [target_yaw, target_yaw + best]
         return [target_yaw]
+
+    def _turned_yaws(
+        self, s: int, world: np.ndarray, normal, yaws: list, target_yaw: float, done: set
+    ) -> list:
+        """Sole yaws (rad) to try on face s beyond `yaws`, where none of those fits a sole at any
+        of the candidate centres world [N, 3]: each way, the smallest of `sole_turns` off
+        `target_yaw` at which one does (`sole_turns`); marked in `done` with the face's group."""
+        turns = self.config.sole_turns
+        if not turns or any(
+            self._inside_face(s, world, sole_rotation_single(normal, yaw)).any() for yaw in yaws
+        ):
+            return []
+        found = []
+        for sign in (1.0, -1.0):
+            for turn in turns:
+                yaw = target_yaw + sign * turn
+                if (self.surfaces.group[s], yaw) in done:
+                    break
+                if self._inside_face(s, world, sole_rotation_single(normal, yaw)).any():
+                    found.append(yaw)
+                    break
+        done.update((self.surfaces.group[s], yaw) for yaw in found)
+        return found
 
     def _inside_face(self, s: int, centres: np.ndarray, rot: np.ndarray) -> np.ndarray:
         """[N] whether soles with centres [N, 3] on face s and orientation rot [3, 3] lie

@@ -1,6 +1,8 @@
 """Balance margins of motions: key postures whose CoM sits at the soles' edge are reached with
-the CoM moved inside (MotionConfig.support_margin), and the tracking controller lands each
-sole on its planned world placement when the robot has crept (SimulationConfig.landing_correction)."""
+the CoM moved inside (MotionConfig.support_margin), the tracking controller lands each
+sole on its planned world placement when the robot has crept (SimulationConfig.landing_correction),
+crouched single supports rise and keep their CoM's acceleration, and the planned sole wrenches
+keep their centres of pressure on their soles (dynamics.static_wrenches)."""
 
 import dataclasses
 
@@ -143,3 +145,63 @@ def test_a_crouched_stance_rises_for_a_swing_sole_behind_it():
     assert (risen[talos.legs[0].q_index] >= lower + LIMIT_MARGIN - 1e-9).all()
     # the same rise without the margin's room is not needed: a lower one reaches
     assert root_dip(talos, crouched, behind, rotation, zero, knees, direction=-1.0) < rise
+
+
+def test_a_crouched_landing_behind_keeps_its_com_acceleration():
+    """Crouched (root 0.13 m below the plan's), a sole landing 0.25 m behind the stance needs the
+    root to rise (no lowering reaches it); the CoM then follows the swing leg's own path, and the
+    landing lasts long enough for its horizontal acceleration to stay within
+    single_support_acceleration (over the 0.8 s landing: 0.86 m/s^2, and eval_bridge's plans
+    failed the equilibrium check there)."""
+    from leas_jax.motion.motion import (
+        _PhaseSpec,
+        _single_support,
+        held_root_configuration,
+        peak_horizontal_acceleration,
+    )
+
+    talos, config = load_talos(), MotionConfig()
+    q = straight_plan(0.3).q[0]
+    feet, _, rotation = posture_frames(talos, q)
+    crouched = held_root_configuration(talos, q, feet, rotation, np.array([0.0, 0.0, -0.13]), np.zeros(2))
+    lifted, landed = feet.copy(), feet.copy()
+    lifted[0][2, 3] += 0.02
+    landed[0][0, 3] -= 0.25
+    start = held_root_configuration(talos, crouched, lifted, rotation, np.zeros(3), np.zeros(2))
+    com = posture_frames(talos, start)[1]
+    samples = round(config.land_duration / config.dt)
+    spec = _PhaseSpec(
+        "land", (0, 1), 0, samples, lifted, landed, com, com, rotation, rotation, start, start, 0.07
+    )
+    lengthened, coms = _single_support(talos, spec, 0, config)
+    assert coms[-1, 2] > coms[0, 2] + 0.01  # the root rose
+    assert lengthened.samples > samples
+    assert len(coms) == lengthened.samples + 1
+    assert peak_horizontal_acceleration(coms, config.dt) <= config.single_support_acceleration
+
+
+def test_static_wrenches_hold_the_weight_on_both_soles():
+    """Soles apart and turned, the CoM off the segment between them: the static split carries the
+    weight, balances it about the CoM, and keeps each centre of pressure on its sole."""
+    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
+    from leas_jax.motion.dynamics import static_wrenches
+
+    soles = np.array([np.eye(4), np.eye(4)])
+    soles[0][:3, 3] = [0.0, 0.1, 0.0]
+    soles[1][:3, 3] = [0.25, -0.05, 0.0]
+    yaw = 0.4
+    soles[1][:2, :2] = [[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]]
+    com = np.array([0.1, 0.0])
+    corners = sole_corners(soles, np.array([True, True]))
+    assert support_margin(corners, com) > 0.0
+    weight = 900.0
+    wrenches = static_wrenches(com, soles, weight)
+    forces = np.array([soles[s][:3, :3] @ wrenches[s, :3] for s in (0, 1)])
+    torques = np.array([soles[s][:3, :3] @ wrenches[s, 3:] for s in (0, 1)])
+    np.testing.assert_allclose(forces.sum(axis=0), [0.0, 0.0, weight], atol=1e-9)
+    levers = soles[:, :3, 3] - np.r_[com, 0.0]
+    moment = torques.sum(axis=0) + np.cross(levers, forces).sum(axis=0)
+    np.testing.assert_allclose(moment, 0.0, atol=1e-9)
+    assert (wrenches[:, 2] > 0.0).all()
+    centres = np.stack([-wrenches[:, 4], wrenches[:, 3]], axis=1) / wrenches[:, 2:3]  # sole frames
+    assert (np.abs(centres[:, 0]) < SOLE_LENGTH / 2).all() and (np.abs(centres[:, 1]) < SOLE_WIDTH / 2).all()

@@ -78,6 +78,18 @@ def test_motion_passes_its_checks(motion):
     assert (np.abs(motion.tau) / talos.model.effortLimit[6:]).max() < 1.0
 
 
+def test_planned_sole_wrenches_keep_their_soles_down(motion):
+    """Every sole in contact pushes with its centre of pressure on its sole rectangle, in double
+    support too (a vertical load split with a least-squares remainder put it up to 9 N m of
+    ankle torque past the sole's edge on this plan)."""
+    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
+
+    w = motion.wrenches[motion.contact]  # [M, 6] sole frame
+    assert (w[:, 2] > 0.0).all()
+    assert (np.abs(w[:, 3]) <= w[:, 2] * SOLE_WIDTH / 2).all()
+    assert (np.abs(w[:, 4]) <= w[:, 2] * SOLE_LENGTH / 2).all()
+
+
 def test_checks_catch_broken_motions(plan, motion):
     talos = load_talos()
     knee = 3  # leg_left_4_joint in the 32 joints

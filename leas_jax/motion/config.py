@@ -50,8 +50,12 @@ class MotionConfig:
     # puts some landing postures' CoM at their heels (eval_stairs: 4.5-7 mm inside, hpp
     # robustness 2-7 where most postures have ~95): the motion's shift there then fails the
     # equilibrium check with the CoM's acceleration, or Talos tips over backwards in MuJoCo
-    # when its tracking error exceeds that margin. 0: every key posture is the plan's own.
-    support_margin: float = 0.03
+    # when its tracking error exceeds that margin. The margin covers the shift's zero-moment
+    # point offset (up to 2.2 cm at `com_acceleration`, above) and the tracked CoM's error
+    # (1-1.5 cm in MuJoCo on eval_bridge's plans): at 0.03 m Talos rolled over the diagonal
+    # edge between two soles' corners in a shift of navigate's eval_bridge plans (the CoM
+    # 1.5-3 cm inside, both soles tilting). 0: every key posture is the plan's own.
+    support_margin: float = 0.05
     # Single support lasts longer than lift_duration or land_duration where the CoM moves
     # far (the root comes down and up on steps): its peak acceleration along the
     # minimum-jerk move stays under this, m/s^2 (on eval_stairs a 0.11 m move in 0.6 s,

@@ -3,9 +3,12 @@
 Host-only, not jittable. `rnea` on a free-flyer model gives 38 generalised forces; its
 first six (the root's) no actuator supplies: the soles in contact must. The contact
 wrenches are the ones that cancel them (unique on one foot; in double support the
-6 equations leave 6 free, taken nearest to a vertical load split by the CoM's position
-between the soles), and the joint torques are what remains: tau = rnea(q, v, a)[6:] -
-J_c[:, 6:]^T f.
+6 equations leave 6 free, taken nearest to the static split `static_wrenches`: each sole
+carries the weight's share of `load_split` with its centre of pressure under the CoM's
+offset from the segment between the soles, so both stay on their soles wherever the CoM
+is over their support polygon; the dynamic remainder is shared in proportion to those
+loads), and the joint torques are what remains: tau =
+rnea(q, v, a)[6:] - J_c[:, 6:]^T f.
 """
 
 from __future__ import annotations
@@ -31,6 +34,33 @@ def load_split(com_xy: np.ndarray, sole_xy: np.ndarray) -> np.ndarray:
         return np.array([0.5, 0.5])
     right = float(np.clip((com_xy - sole_xy[0]) @ axis / length2, 0.0, 1.0))
     return np.array([1.0 - right, right])
+
+
+def static_wrenches(com_xy: np.ndarray, soles: np.ndarray, weight: float) -> np.ndarray:
+    """Sole wrenches [2, 6] (force, torque at the sole frame, sole frame) that hold `weight` N
+    still with the CoM over com_xy [2] (world), both soles on the ground at soles [2, 4, 4]
+    (world placements).
+
+    Each sole carries its `load_split` share vertically, at the centre of pressure o_i + d in
+    its sole plane (o_i: its centre; d: the CoM's horizontal offset from the shares' point
+    on the segment between the centres, the same for both soles). The centres of pressure
+    then average to the CoM, so the wrenches balance the weight about it; where the CoM is
+    over the soles' support polygon, d is within a sole's half-width of the segment.
+    (A vertical split alone would leave the moment of that offset to the least-squares
+    correction of `contact_torques`, which puts most of it on one ankle: centres of pressure
+    up to 0.27 m off a 0.13 m-wide sole in navigate's eval_bridge plans.)
+    """
+    centres = soles[:, :2, 3]
+    shares = load_split(com_xy, centres)
+    offset = np.r_[com_xy - shares @ centres, 0.0]
+    out = np.zeros((2, 6))
+    for side in (0, 1):
+        rotation = soles[side][:3, :3]
+        force = rotation.T @ np.array([0.0, 0.0, shares[side] * weight])
+        lever = rotation.T @ offset
+        lever[2] = 0.0  # in the sole plane
+        out[side] = np.r_[force, np.cross(lever, force)]
+    return out
 
 
 def contact_torques(model, data, q, v, a, frames, contact, mass: float):
@@ -60,18 +90,18 @@ def contact_torques(model, data, q, v, a, frames, contact, mass: float):
     jacs = [pin.getFrameJacobian(model, data, frames[side], pin.ReferenceFrame.LOCAL) for side in sides]
     # root rows: sum_i J_i[:, :6]^T f_i = full[:6]
     root = np.hstack([jac[:, :6].T for jac in jacs])  # [6, 6 n]
-    desired = np.zeros(6 * len(sides))
     if len(sides) == 2:
         com = pin.centerOfMass(model, data, q, False)
-        sole_xy = np.array([data.oMf[frames[s]].translation[:2] for s in (0, 1)])
-        shares = load_split(com[:2], sole_xy)
-    else:
-        shares = np.ones(1)
-    for k, side in enumerate(sides):
-        world_force = np.array([0.0, 0.0, shares[k] * mass * GRAVITY])
-        desired[6 * k : 6 * k + 3] = data.oMf[frames[side]].rotation.T @ world_force
-    # f = f_des + A^T (A A^T)^-1 (b - A f_des): the wrenches nearest f_des meeting the root rows
-    correction = root.T @ np.linalg.solve(root @ root.T, full[:6] - root @ desired)
+        soles = np.array([data.oMf[frames[s]].homogeneous for s in (0, 1)])
+        desired = static_wrenches(com[:2], soles, mass * GRAVITY).reshape(-1)
+        weights = np.repeat(load_split(com[:2], soles[:, :2, 3]), 6)
+    else:  # one foot: the wrench is unique
+        desired, weights = np.zeros(6), np.ones(6)
+    # f = f_des + W A^T (A W A^T)^-1 (b - A f_des): the wrenches nearest f_des in the metric
+    # W^-1 that meet the root rows; W, each sole's load share, gives the dynamic remainder to
+    # the soles in proportion to their load (none to a sole about to lift or just landed)
+    spread = weights[:, None] * root.T
+    correction = spread @ np.linalg.solve(root @ spread, full[:6] - root @ desired)
     stacked = desired + correction
     tau = full[6:].copy()
     for k, side in enumerate(sides):

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import io
+import math
 import os
 from dataclasses import dataclass, field
 
@@ -75,6 +76,10 @@ MAX_RISE = 0.15
 # that works (else none), rad: the whole-body IK tracks their CoM, not their root, and ends
 # a few mrad off them (measured on eval_bridge's crouched plans: an ankle 0.1 mrad past).
 LIMIT_MARGIN = 0.03
+# A single-support phase is lengthened at most this many times for its CoM's acceleration
+# (`_single_support`; one is enough where its references scale with its duration, the next
+# ones take up the samples' rounding).
+STRETCHES = 4
 
 
 class MotionError(LeasError):
@@ -690,26 +695,51 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) 
 
 
 def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[_PhaseSpec, np.ndarray]:
-    """A lift or land spec, lengthened where its CoM moves far, and its `single_support_coms`
-    [n + 1, 3] of samples 0..n.
+    """A lift or land spec, lengthened where its CoM moves far or fast, and its
+    `single_support_coms` [n + 1, 3] of samples 0..n.
 
-    The phase lasts long enough for the CoM's peak acceleration along its minimum-jerk
-    move to stay under `config.single_support_acceleration` (`paths.shift_duration`).
+    The phase lasts long enough for the CoM to stay under `config.single_support_acceleration`:
+    its peak acceleration along a minimum-jerk move of its end-to-end distance
+    (`paths.shift_duration`) and the peak horizontal acceleration of its references
+    (`stretched_samples`: where the root rises, the CoM follows the swing leg's own path, on
+    the swing windows). The references are functions of normalised time, so a longer phase
+    has them slower; up to STRETCHES lengthenings.
 
     Raises:
         MotionError: naming postures k and k + 1.
     """
     from leas_jax.motion.paths import shift_duration
 
+    limit, dt = config.single_support_acceleration, config.dt
     coms = _single_support_coms(talos, spec, k, config)
-    distance = float(np.linalg.norm(coms[-1] - coms[0]))
-    seconds = shift_duration(
-        distance, config.single_support_acceleration, spec.samples * config.dt, config.dt
-    )
-    if round(seconds / config.dt) > spec.samples:
-        spec = dataclasses.replace(spec, samples=round(seconds / config.dt))
+    for _ in range(STRETCHES):
+        distance = float(np.linalg.norm(coms[-1] - coms[0]))
+        seconds = shift_duration(distance, limit, spec.samples * dt, dt)
+        samples = max(round(seconds / dt), stretched_samples(coms, spec.samples, limit, dt))
+        if samples <= spec.samples:
+            break
+        spec = dataclasses.replace(spec, samples=samples)
         coms = _single_support_coms(talos, spec, k, config)
     return spec, coms
+
+
+def peak_horizontal_acceleration(points: np.ndarray, dt: float) -> float:
+    """Largest horizontal acceleration, m/s^2, of points [M, 3] (world, m) sampled every dt s,
+    by second differences (0 under 3 samples)."""
+    if len(points) < 3:
+        return 0.0
+    second = (points[2:, :2] - 2.0 * points[1:-1, :2] + points[:-2, :2]) / dt**2
+    return float(np.linalg.norm(second, axis=1).max())
+
+
+def stretched_samples(points: np.ndarray, samples: int, limit: float, dt: float) -> int:
+    """Samples (at least `samples`) of a phase whose path points [samples + 1, 3] (world, m; a
+    function of normalised time) keeps its peak horizontal acceleration within `limit`, m/s^2,
+    when played over them: accelerations scale with the inverse square of the duration."""
+    peak = peak_horizontal_acceleration(points, dt)
+    if peak <= limit:
+        return samples
+    return max(samples, math.ceil(samples * math.sqrt(peak / limit) - 1e-9))
 
 
 def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> np.ndarray:

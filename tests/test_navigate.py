@@ -1,5 +1,6 @@
 """Navigate: the lattice search (eval_bridge's beam, eval_hole's detour) and the closed loop
-(replanning after an injected generator failure, unreachable goals, determinism).
+(replanning after an injected generator failure or a stalled rollout, unreachable goals,
+determinism).
 
 The closed-loop tests inject `plan_fn` (the pool's test hook): a generator stand-in that
 stops every guide where it enters a blocked disk, so they run in seconds and fail where the
@@ -17,7 +18,7 @@ from navigate_helpers import plan_until
 from leas_jax.contacts.validation.pool import ValidationPool
 from leas_jax.navigate import result as reasons
 from leas_jax.navigate.lattice import build_lattice, heading_index
-from leas_jax.navigate.loop import NavigateConfig, Navigator
+from leas_jax.navigate.loop import NavigateConfig, Navigator, stall_start
 from leas_jax.navigate.search import search
 from leas_jax.terrain import load_terrain, loads_terrain
 
@@ -140,6 +141,49 @@ def test_replans_around_an_injected_generator_failure(policy):
     assert np.min(np.hypot(*(result.guide[:, :2] - BLOCK).T)) >= BLOCK_RADIUS
     assert result.attempts[-1].begin > 0  # the last attempt grew a verified prefix
     assert set(result.seconds) >= {"lattice", "search", "rollout", "contact_planning"}
+
+
+def test_stall_start_finds_where_a_guide_marks_time():
+    """The first pose of a guide's tail that stays within the radius of it, when that tail is long
+    enough; None for a guide that moves on to its end or stalls too briefly."""
+    walk = np.stack([np.linspace(0.0, 1.0, 51), np.zeros(51), np.ones(51), np.zeros(51)], axis=1)
+    jitter = 0.05 * np.sin(np.arange(1, 61))[:, None] * np.array([1.0, 1.0, 0.0, 0.0])
+    stalled = np.concatenate([walk, walk[-1] + jitter])  # 60 poses within 0.071 m of pose 50
+    # the earliest pose whose later ones all lie within 0.25 m of it: up to 0.25 m before pose 50
+    assert stall_start(stalled, steps=50, radius=0.25) in range(37, 51)
+    assert stall_start(stalled, steps=50, radius=0.05) is None  # the jitter leaves a 0.05 m disk
+    assert stall_start(stalled[:80], steps=50, radius=0.25) is None  # 30 poses: too brief
+    assert stall_start(walk, steps=5, radius=0.01) is None
+
+
+def test_a_stalled_rollout_is_cut_and_searched_round(policy, monkeypatch):
+    """A rollout that marks time at x = 3 for its last 10 s (LeaS before ground it does not take)
+    is cut there, the generator (covering everything here) plans only the walked part, and the
+    stall is penalised and searched round like a generator failure: the next rollout reaches."""
+    real = Navigator._rollout
+    calls = []
+
+    def stalls_first(self, poses, speeds, waypoints):
+        guides = real(self, poses, speeds, waypoints)
+        if not calls:
+            guide = guides[0]
+            at = int(np.flatnonzero(guide[:, 0] >= 3.0)[0])
+            guides = [np.concatenate([guide[: at + 1], np.repeat(guide[at : at + 1], 100, axis=0)])]
+        calls.append(len(guides[0]))
+        return guides
+
+    monkeypatch.setattr(Navigator, "_rollout", stalls_first)
+    lines = []
+    navigator = Navigator(policy, loads_terrain(SLAB), NavigateConfig(), progress=lines.append)
+    full = lambda terrain, guide, timestep, config: plan_until(guide, len(guide) - 1)  # noqa: E731
+    with ValidationPool(navigator.terrain, workers=0, plan_fn=full, return_plans=True) as pool:
+        (result,) = navigator.run([navigator.query((1.0, 2.0, 0.0), (5.0, 2.0))], pool=pool)
+    assert result.success, result.message
+    first = result.attempts[0]
+    assert first.guide_length < calls[0] - 90  # the stalled poses were not planned
+    assert first.failure is not None and np.hypot(first.failure[0] - 3.0, first.failure[1] - 2.0) < 0.3
+    assert any("the policy stalls at" in line and "cut there" in line for line in lines)
+    assert result.replans >= 1
 
 
 def test_without_replans_the_injected_failure_ends_the_query(policy):

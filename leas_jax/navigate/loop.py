@@ -5,7 +5,9 @@ One query runs, in a closed loop with the contact generator:
 1. search: the cheapest lattice path from the current pose through the remaining route points
    to the goal (`search`, over the valid set of `lattice`), cut into waypoints;
 2. policy rollout: the LeaS policy walks along those waypoints (`steering.leas.rollout_batch`,
-   rolling on through poses the reachability condition rejects: the generator judges);
+   rolling on through poses the reachability condition rejects: the generator judges); a
+   rollout that stalls away from the goal is cut where it stalled (`stall_start`), and the
+   stall counts as a failure there (step 4);
 3. contact planning: the generator validates the whole guide grown so far (the verified
    prefix of the previous attempts plus the new segment; one `ValidationPool` task);
 4. where it stops short, the cells within `failure_radius` of where it failed are penalised,
@@ -35,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from leas_jax.contacts.metrics import SUCCESS_RADIUS
 from leas_jax.contacts.planner.config import GeneratorConfig
 from leas_jax.errors import UsageError
 from leas_jax.navigate import result as reasons
@@ -72,6 +75,16 @@ class NavigateConfig:
     # m: cells this close to a verified guide pose are trusted (a doubtful move into them costs
     # nothing extra); about the half-width of the feet's stance (0.085 m each side) plus a cell
     trust_radius: float = 0.15
+    # s and m: a rollout that ends away from the goal with its last `stall_time` or more within
+    # `stall_radius` of one pose has stalled there (LeaS dithering before ground it does not
+    # take: the entrance of rubbles_stairs_2's rubble, where the policy marked time for 100 s
+    # of every 120 s rollout, each replan walking on into the same stall). The guide is cut at
+    # the stall and the stall is treated as a failure of the generator there (penalised,
+    # searched round), which also spares the generator planning the stalled poses
+    # (test_a_stalled_rollout_is_cut_and_searched_round). A quarter turn in place at the
+    # policy's 0.35 rad/s takes about 4.5 s. stall_time None: never.
+    stall_time: float | None = 5.0
+    stall_radius: float = 0.25
     generator: object = None  # `GeneratorConfig` of the contact generator (None: its defaults)
 
 
@@ -106,6 +119,7 @@ class _State:
     search: SearchResult | None = None
     path: np.ndarray | None = None
     waypoints: np.ndarray | None = None
+    stalled: bool = False  # the guide's last segment was cut where the policy stalled (`stall_start`)
     attempts: list = field(default_factory=list)
     best: tuple | None = None  # (final distance, plan, guide)
     unreachable: str | None = None  # the first search reason that the goal cannot be reached
@@ -121,6 +135,17 @@ def _jitted_terms():
     from leas_jax.env import reachability
 
     return jax.jit(reachability.terms, static_argnums=2)
+
+
+def stall_start(guide: np.ndarray, steps: int, radius: float) -> int | None:
+    """Index of the pose where a guide [T, 4] stalls: the earliest pose i such that every pose
+    from i to the end lies within `radius` (m, horizontally) of pose i, when those are at least
+    `steps` poses after it; None where the guide's tail moves on (host, pure)."""
+    xy = np.asarray(guide)[:, :2]
+    begin = len(xy) - 1
+    while begin > 0 and np.all(np.hypot(*(xy[begin:] - xy[begin - 1]).T) <= radius):
+        begin -= 1
+    return begin if len(xy) - 1 - begin >= steps else None
 
 
 def _fmt(xy) -> str:
@@ -351,7 +376,8 @@ class Navigator:
         pending = {}
         for k, (state, guide) in enumerate(zip(states, guides)):
             state.seconds["rollout"] += share
-            state.guide, state.segment_begin = guide, 0
+            state.guide, state.segment_begin = self._cut_stall(k, state, guide), 0
+            guide = state.guide
             state.path, state.waypoints = state.search.path, state.search.waypoints
             self.say(f"query {k}: rollout {len(guide)} poses ({share:.2f} s)")
             pending[pool.submit([guide], self.env.timestep)] = k
@@ -401,6 +427,9 @@ class Navigator:
             generator = cfg.generator or GeneratorConfig()
             pose = guide[min(last + generator.planning_stride(self.env.timestep), total - 1)]
             failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
+        elif not outcome.success and state.stalled:  # covered up to where the policy stalled
+            pose = guide[-1]
+            failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
         state.attempts.append(
             Attempt(
                 state.segment_begin,
@@ -430,10 +459,13 @@ class Navigator:
             if state.unreachable is not None:
                 return self._finish(state, state.unreachable, self._unreachable_text(state), k)
             where = guide[-1, :2] if failure is None else failure
+            who = (
+                "the policy stalls" if state.stalled and last >= total - 1 else "the contact generator stops"
+            )
             return self._finish(
                 state,
                 reasons.REPLAN_LIMIT,
-                f"the contact generator still stops near {_fmt(where)} after {cfg.max_replans} replans",
+                f"{who} near {_fmt(where)} after {cfg.max_replans} replans",
                 k,
             )
         if failure is None:  # the whole guide is verified: walk on from its end
@@ -455,6 +487,8 @@ class Navigator:
             else query.speed
         )
         avoid = "walking on" if failure is None else f"avoiding {_fmt(failure)}"
+        if failure is not None and state.stalled and last >= total - 1:
+            avoid += " (the policy stalled there)"
         self.say(f"query {k}: replan {len(state.attempts)} from guide pose {begin} {_fmt(pose[:2])}, {avoid}")
         began = time.perf_counter()
         try:
@@ -472,9 +506,26 @@ class Navigator:
         (segment,) = self._rollout(pose[None], np.array([speed]), [state.search.waypoints])
         state.seconds["rollout"] += time.perf_counter() - began
         state.path, state.waypoints = state.search.path, state.search.waypoints
-        state.guide = np.concatenate([guide[:begin], segment])
+        state.guide = np.concatenate([guide[:begin], self._cut_stall(k, state, segment)])
         state.segment_begin = begin
         return state.guide
+
+    def _cut_stall(self, k: int, state: _State, segment: np.ndarray) -> np.ndarray:
+        """A new rollout segment [T, 4], cut after the pose where the policy stalled
+        (`stall_start`; `state.stalled` says whether it was)."""
+        cfg = self.config
+        begin = None
+        if cfg.stall_time is not None and np.hypot(*(segment[-1, :2] - state.query.goal)) > SUCCESS_RADIUS:
+            steps = int(math.ceil(cfg.stall_time / self.env.timestep))
+            begin = stall_start(segment, steps, cfg.stall_radius)
+        state.stalled = begin is not None
+        if begin is None:
+            return segment
+        self.say(
+            f"query {k}: the policy stalls at {_fmt(segment[begin, :2])} for the last "
+            f"{(len(segment) - 1 - begin) * self.env.timestep:.0f} s of its rollout: cut there"
+        )
+        return segment[: begin + 1]
 
     def _cells_under(self, xy: np.ndarray) -> np.ndarray:
         """[nx, ny] bool: lattice cells within `trust_radius` of any of the points [P, 2] (world)."""

@@ -2,7 +2,7 @@
 intervals, coverage, navigate's replans and the reasons it stops.
 
     python docs/results/2026-12-06-rough-scenes/summarise.py FOLDER
-reads FOLDER/*/*/results.json (eval/ and baselines/), writes FOLDER/summary.json and
+reads FOLDER/eval/*/results.json and FOLDER/baselines/*/results.json, writes FOLDER/summary.json and
 FOLDER/summary.md, rows sorted by scene then method.
 """
 
@@ -60,7 +60,7 @@ def table(rows: list[dict]) -> str:
 
 def main(folder: Path) -> None:
     rows = []
-    for path in sorted(folder.glob("*/*/results.json")):
+    for path in sorted([*folder.glob("eval/*/results.json"), *folder.glob("baselines/*/results.json")]):
         rows += scene_rows(json.loads(path.read_text()))
     rank = {m: k for k, m in enumerate(ORDER)}
     rows.sort(key=lambda r: (r["scene"], rank.get(r["method"], len(ORDER))))

@@ -30,7 +30,8 @@ Rates come with 95 % Wilson intervals.
 
 Writes <out>/motion_execution_<variant>.json and <out>/motion_execution_<variant>.md.
 
-Results: --out (default benchmarks/results/motion); the run kept is docs/results/2026-12-06-motion/.
+Results: --out (default benchmarks/results/motion); the runs kept are docs/results/2026-12-06-motion/
+and docs/results/2026-12-06-motion-landings/.
 """
 
 from __future__ import annotations

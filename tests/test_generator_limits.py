@@ -3,7 +3,8 @@ climbed by holding the root back over the lower sole (`GeneratorConfig.step_up_r
 a field of debris tiles narrower than a turned sole is crossed by turning the soles to fit
 (`GeneratorConfig.sole_turns`)."""
 
-import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +13,9 @@ from leas_jax.contacts import GeneratorConfig, verify
 from leas_jax.contacts.planner.generator import ContactGenerator
 from leas_jax.contacts.planner.projection import rotz
 from leas_jax.terrain import loads_terrain
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "studies"))
+from generator_debris import debris_terrain, diagonal_guide  # noqa: E402
 
 DT = 0.1  # s between guide poses
 SPEED = 0.18  # m/s, the env's target speed
@@ -86,30 +90,6 @@ def test_the_root_is_held_back_only_for_a_sole_above_and_ahead_of_the_other():
 def test_held_back_distances_stay_within_the_root_bound():
     with pytest.raises(ValueError, match="step_up_root_shifts"):
         GeneratorConfig(step_up_root_shifts=(0.2,))
-
-
-def debris_terrain(tilt_deg: float = 15.0):
-    """Flat ground, then 5 columns of 0.29 x 0.19 m debris tiles (x 1.5-3.0 m, their tops about
-    z = 0) each tilted by `tilt_deg` about x or y in turn, then flat ground (5 x 4 m): the
-    tiles of hpp-environments' slalom_debris, which hold the 0.20 x 0.13 m sole only within
-    0.28 rad of one of their axes."""
-    tilt = math.radians(tilt_deg)
-    text = 'name = "debris"\nbounds = [[0.0, 0.0], [5.0, 4.0]]\nvoid_height = -2.0\nresolution = 0.02\n'
-    text += "[[box]]\ncenter = [0.75, 2.0, -0.25]\nsize = [1.5, 4.0, 0.5]\n"
-    text += "[[box]]\ncenter = [4.0, 2.0, -0.25]\nsize = [2.0, 4.0, 0.5]\n"
-    for i, x in enumerate(np.arange(1.65, 3.0, 0.3)):
-        for j, y in enumerate(np.arange(0.1, 4.0, 0.2)):
-            roll, pitch = [(tilt, 0.0), (-tilt, 0.0), (0.0, tilt), (0.0, -tilt)][(i + 2 * j) % 4]
-            text += f"[[box]]\ncenter = [{x:.3f}, {y:.3f}, -0.05]\nsize = [0.29, 0.19, 0.1]\nrpy = [{roll}, {pitch}, 0.0]\n"
-    return loads_terrain(text)
-
-
-def diagonal_guide(yaw: float, length: float = 3.0) -> np.ndarray:
-    """[T, 4] straight guide from (0.8, 1.2) at heading `yaw` over the debris, root ROOT high."""
-    count = int(length / (SPEED * DT)) + 1
-    along = np.linspace(0.0, length, count)
-    x, y = 0.8 + along * math.cos(yaw), 1.2 + along * math.sin(yaw)
-    return np.stack([x, y, np.full(count, ROOT), np.full(count, yaw)], axis=1)
 
 
 def test_a_sole_turns_to_fit_a_small_tile():

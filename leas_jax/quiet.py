@@ -1,4 +1,5 @@
-"""The notice of mujoco.mjx's optional GPU backend, kept off the command line.
+"""Libraries' notices kept off the command line: mujoco.mjx's optional GPU backend, the LP's
+debug line of hpp-centroidal-dynamics (`c_stdout_discarded`).
 
 brax imports mujoco.mjx, whose optional backend `mujoco.mjx.warp` prints "Failed to import
 warp: ..." and "Failed to import mujoco_warp: ..." on stdout where warp is not installed,
@@ -13,6 +14,7 @@ import contextlib
 import importlib.abc
 import importlib.machinery
 import io
+import os
 import sys
 
 WARP_MODULE = "mujoco.mjx.warp"
@@ -51,3 +53,29 @@ def silence_warp_notice() -> None:
     """Put a `QuietWarpFinder` first on `sys.meta_path` (once; later calls do nothing)."""
     if not any(isinstance(finder, QuietWarpFinder) for finder in sys.meta_path):
         sys.meta_path.insert(0, QuietWarpFinder())
+
+
+_DEVNULL: list[int] = []  # the process's descriptor of os.devnull, opened on first use
+
+
+@contextlib.contextmanager
+def c_stdout_discarded():
+    """Discard what compiled code writes on file descriptor 1 inside the block.
+
+    hpp-centroidal-dynamics prints "[DEBUG centroidal_dynamics.cpp 269] Primal LP problem could
+    not be solved: 4" on stdout (std::cout, not Python's sys.stdout) where qpOASES fails an LP
+    that `HppEquilibrium` then solves with CLP; in a command's output it reads like an error.
+    Planning (`contacts.validation.runner.PathRunner.run`) and `contacts.verify` run their LPs
+    inside it. (Not in `HppEquilibrium` itself: the generator's code is in the key of its
+    labels, `feasibility.spawns.GENERATOR_SOURCES`, and an edit there makes them stale.)
+    Python's own buffered output is not lost (it reaches the descriptor after the block). About
+    4 us a block, 1-2 % of one LP."""
+    if not _DEVNULL:
+        _DEVNULL.append(os.open(os.devnull, os.O_WRONLY))
+    saved = os.dup(1)
+    try:
+        os.dup2(_DEVNULL[0], 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)

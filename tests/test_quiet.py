@@ -1,4 +1,5 @@
-"""The command line prints no notice of mujoco.mjx's optional warp backend (leas_jax.quiet)."""
+"""The command line prints no notice of mujoco.mjx's optional warp backend nor the equilibrium
+LP's debug line (leas_jax.quiet)."""
 
 import subprocess
 import sys
@@ -41,3 +42,20 @@ def test_brax_imports_the_backend_quietly():
     done = _python("-c", code)
     assert done.returncode == 0, done.stderr
     assert done.stdout == "['mujoco.mjx.warp']\n"
+
+
+def test_compiled_code_writes_on_stdout_are_discarded_inside_the_block_only():
+    """What is written on descriptor 1 inside `c_stdout_discarded` (as hpp-centroidal-dynamics'
+    std::cout does) is gone; before and after it, and Python's own print, reach stdout."""
+    code = (
+        "import os\n"
+        "from leas_jax.quiet import c_stdout_discarded\n"
+        "os.write(1, b'before\\n')\n"
+        "with c_stdout_discarded():\n"
+        "    os.write(1, b'[DEBUG] inside\\n')\n"
+        "os.write(1, b'after\\n')\n"
+        "print('printed', flush=True)\n"
+    )
+    done = _python("-c", code)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "before\nafter\nprinted\n"

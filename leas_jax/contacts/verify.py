@@ -100,6 +100,7 @@ def verify(plan, terrain=None) -> VerificationReport:
     from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
     from leas_jax.contacts.robot.equilibrium import HppEquilibrium, sole_corners
     from leas_jax.contacts.robot.model import load_talos
+    from leas_jax.quiet import c_stdout_discarded
     from leas_jax.terrain import loads_terrain
     from leas_jax.terrain.sources import mesh_hash_mismatches
 
@@ -203,7 +204,8 @@ def verify(plan, terrain=None) -> VerificationReport:
             points, normals = sole_corners(feet[contact[k]])
             equilibrium.set_contacts(points, normals)
             com = talos.com(q)
-            robustness = equilibrium.robustness(com)
+            with c_stdout_discarded():  # the LP's debug line where qpOASES fails (CLP answers)
+                robustness = equilibrium.robustness(com)
             if not robustness >= 0.0:
                 fail.append(
                     (

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from leas_jax.errors import LeasError
+from leas_jax.quiet import c_stdout_discarded
 
 
 class ValidationPoolError(LeasError):
@@ -183,7 +184,10 @@ class PathRunner:
         random.seed(seed)
         start = time.perf_counter()
         try:
-            plan = self._plan(guide, timestep, seed)
+            # hpp-centroidal-dynamics prints a debug line on stdout where qpOASES fails an LP
+            # (CLP answers then): kept out of the command's output
+            with c_stdout_discarded():
+                plan = self._plan(guide, timestep, seed)
             coverage = float(plan.coverage)
             last_valid = int(plan.last_valid_index)
         except Exception as exc:

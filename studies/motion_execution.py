@@ -401,8 +401,10 @@ def markdown(report: dict) -> str:
         sc = report["scenarios"][name]
         causes = ", ".join(f"{k}: {v}" for k, v in sorted(row["causes"].items())) or "-"
         if sc.get("skipped"):
-            causes += "; not executed: " + ", ".join(
-                f"{e['plan']} ({e['postures']} postures)" for e in sc["skipped"]
+            causes = (
+                ("" if causes == "-" else causes + "; ")
+                + "not executed: "
+                + ", ".join(f"{e['plan']} ({e['postures']} postures)" for e in sc["skipped"])
             )
         lines.append(
             f"| {name} | {sc.get('method', 'rblin')} | {sc['starts']} | {sc['verified_plans']} | {_pct(row['executed'])} "

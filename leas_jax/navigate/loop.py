@@ -148,6 +148,12 @@ def stall_start(guide: np.ndarray, steps: int, radius: float) -> int | None:
     return begin if len(xy) - 1 - begin >= steps else None
 
 
+def _ahead(pose: np.ndarray, config: NavigateConfig) -> np.ndarray:
+    """[2] world centre of the disk penalised after a failure at guide pose [4] (x, y, z, yaw):
+    `failure_radius` / 2 ahead of it along its heading."""
+    return pose[:2] + 0.5 * config.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
+
+
 def _fmt(xy) -> str:
     return "(" + ", ".join(f"{float(v):.2f}" for v in np.asarray(xy).reshape(-1)) + ")"
 
@@ -425,11 +431,9 @@ class Navigator:
         failure = None
         if not outcome.success and 0 <= last < total - 1:
             generator = cfg.generator or GeneratorConfig()
-            pose = guide[min(last + generator.planning_stride(self.env.timestep), total - 1)]
-            failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
+            failure = _ahead(guide[min(last + generator.planning_stride(self.env.timestep), total - 1)], cfg)
         elif not outcome.success and state.stalled:  # covered up to where the policy stalled
-            pose = guide[-1]
-            failure = pose[:2] + 0.5 * cfg.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
+            failure = _ahead(guide[-1], cfg)
         state.attempts.append(
             Attempt(
                 state.segment_begin,
@@ -460,7 +464,9 @@ class Navigator:
                 return self._finish(state, state.unreachable, self._unreachable_text(state), k)
             where = guide[-1, :2] if failure is None else failure
             who = (
-                "the policy stalls" if state.stalled and last >= total - 1 else "the contact generator stops"
+                "the policy still stalls"
+                if state.stalled and last >= total - 1
+                else "the contact generator still stops"
             )
             return self._finish(
                 state,

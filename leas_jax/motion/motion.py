@@ -526,10 +526,12 @@ def single_support_coms(
             needs, sign = rises, -1.0
         depth = sign * dip_depth(needs, weight)
         if not -MAX_RISE <= depth <= MAX_DIP:
-            raise MotionError(
-                f"the root would come down {depth:.3f} m (over {MAX_DIP:g} m) or rise {-depth:.3f} m "
-                f"(over {MAX_RISE:g} m) for the soles to reach"
+            move = (
+                f"come down {depth:.3f} m (at most {MAX_DIP:g} m)"
+                if depth > 0
+                else (f"rise {-depth:.3f} m (at most {MAX_RISE:g} m)")
             )
+            raise MotionError(f"the root would have to {move} for the soles to reach")
         coms = np.empty((len(feet), 3))
         for i, (f, shift) in enumerate(zip(feet, shifts)):
             offset = np.r_[shift, -depth * weight[i]]

@@ -429,10 +429,12 @@ class Navigator:
             state.trusted |= self._cells_under(guide[: last + 1, :2])
         # where the generator stopped (None: it covered the whole guide, the policy stopped short)
         failure = None
+        # the generator covered the whole guide, cut where the policy stalled
+        policy_stalled = not outcome.success and state.stalled and last >= total - 1
         if not outcome.success and 0 <= last < total - 1:
             generator = cfg.generator or GeneratorConfig()
             failure = _ahead(guide[min(last + generator.planning_stride(self.env.timestep), total - 1)], cfg)
-        elif not outcome.success and state.stalled:  # covered up to where the policy stalled
+        elif policy_stalled:
             failure = _ahead(guide[-1], cfg)
         state.attempts.append(
             Attempt(
@@ -463,11 +465,7 @@ class Navigator:
             if state.unreachable is not None:
                 return self._finish(state, state.unreachable, self._unreachable_text(state), k)
             where = guide[-1, :2] if failure is None else failure
-            who = (
-                "the policy still stalls"
-                if state.stalled and last >= total - 1
-                else "the contact generator still stops"
-            )
+            who = "the policy still stalls" if policy_stalled else "the contact generator still stops"
             return self._finish(
                 state,
                 reasons.REPLAN_LIMIT,
@@ -493,7 +491,7 @@ class Navigator:
             else query.speed
         )
         avoid = "walking on" if failure is None else f"avoiding {_fmt(failure)}"
-        if failure is not None and state.stalled and last >= total - 1:
+        if policy_stalled:
             avoid += " (the policy stalled there)"
         self.say(f"query {k}: replan {len(state.attempts)} from guide pose {begin} {_fmt(pose[:2])}, {avoid}")
         began = time.perf_counter()

@@ -43,6 +43,14 @@ class MotionConfig:
     # eval_stairs: 0.05 rad drives the swing knee past its 7 rad/s limit at lift-off).
     lean: float = 0.015
     min_knee: float = 0.3
+    # Where no single depth (or rise) on the contact weight lets the legs reach every sample
+    # of a single support, the root's height is chosen sample by sample inside what reaches,
+    # the least-jerk profile at rest at both ends (`motion.profiled_single_support_coms`).
+    # navigate's plans on rough scenes need it: rubbles_stairs_2_0's landing 49 -> 50 needs
+    # the root 3-9 cm higher late in the swing but at most 1 cm higher at the contact, and
+    # rubble_0's landing 75 -> 76 a 0.14 m rise in mid-swing (MAX_RISE: 0.15 m on the weight).
+    # Only phases the held-root depth cannot make use it. False: those phases fail as before.
+    profiled_reach: bool = True
     # Double-support key postures whose CoM lies closer than this to the edge of their soles'
     # support polygon (convex hull of both soles' corners, horizontal projection), m, are
     # reached with their CoM moved towards the polygon's centre until it is this far inside

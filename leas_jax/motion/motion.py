@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import io
+import itertools
 import math
 import os
 from dataclasses import dataclass, field
@@ -72,10 +73,18 @@ DIP_SCAN = 0.01
 # plans (navigate's on eval_bridge, knees at 1.4-1.7 rad) lift a swing sole behind the root
 # with its ankle past its -1.31 rad pitch limit; a higher root unbends that leg.
 MAX_RISE = 0.15
+# ... and where the height is chosen sample by sample (`reach_interval`), up to this far up,
+# m: its smoothing must leave room above a needed rise (rubble_0's landing 75 -> 76 needs
+# 0.139 m in mid-swing; capped at MAX_RISE, the profile kinked there at 12 m/s^2).
+MAX_PROFILE_RISE = 0.3
 # Single-support configurations keep their leg joints this far inside their limits where
 # that works (else none), rad: the whole-body IK tracks their CoM, not their root, and ends
 # a few mrad off them (measured on eval_bridge's crouched plans: an ankle 0.1 mrad past).
 LIMIT_MARGIN = 0.03
+# A root height chosen sample by sample (`dip_profile`) keeps this far, m, inside what reaches
+# where there is room: its smoothing then stays off the corners of those bounds (a corner
+# followed exactly gave rubble_0's landing 75 -> 76 a 12 m/s^2 vertical CoM acceleration).
+DIP_INSET = 0.005
 # A single-support phase is lengthened at most this many times for its CoM's acceleration
 # (`_single_support`; one is enough where its references scale with its duration, the next
 # ones take up the samples' rounding).
@@ -549,6 +558,132 @@ def single_support_coms(
         return attempt(0.0)
 
 
+def profiled_single_support_coms(
+    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+) -> np.ndarray:
+    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1 whose root
+    height is chosen sample by sample: where no single depth on the contact weight reaches
+    every sample (`single_support_coms` fails: the swing leg needs the root high at one sample
+    and low at another, or a rise over MAX_RISE close to the key posture).
+
+    Arguments as `single_support_coms`. The root keeps the key posture's horizontal position
+    (else moved `config.lean` along the stance sole, as there); its lowering at each sample
+    lies inside what reaches (`reach_interval`, leg joints LIMIT_MARGIN inside their limits,
+    else 0), the smoothest such profile at rest at both ends (`dip_profile`). The CoM is that
+    of those configurations (no blend: the whole-body IK reproduces their roots).
+
+    Raises:
+        MotionError: some sample's soles are out of reach at every height, or
+            `config.profiled_reach` is off.
+    """
+    import pinocchio as pin
+
+    if not config.profiled_reach:
+        raise MotionError("the root's height is not chosen sample by sample (MotionConfig.profiled_reach)")
+    weight = contact_weight(len(feet), lifting)
+    bent = np.array([q[leg.q_index[3]] for leg in talos.legs])
+    knees = config.min_knee - np.maximum(config.min_knee - bent, 0.0) * (1.0 - weight[:, None])  # [M, 2]
+    contact = feet[0 if lifting else -1]
+    ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
+    toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
+    data = talos.model.createData()
+    lean = config.lean * weight[:, None] * toward
+    unreached = 0
+    for shifts, margin in itertools.product((np.zeros((len(feet), 2)), lean), (LIMIT_MARGIN, 0.0)):
+        low, high = np.array(
+            [reach_interval(talos, q, *sample, margin) for sample in zip(feet, rotations, shifts, knees)]
+        ).T
+        key = weight < 1e-3
+        if np.isnan(low).any() or (low[key] > 0.0).any() or (high[key] < 0.0).any():
+            unreached = int(np.flatnonzero(np.isnan(low) | (key & ((low > 0.0) | (high < 0.0))))[0])
+            continue
+        dips = dip_profile(low, high, weight)
+        offsets = np.c_[shifts, -dips]
+        configurations = [
+            held_root_configuration(talos, q, *sample, margin)
+            for sample in zip(feet, rotations, offsets, knees)
+        ]
+        if any(c is None for c in configurations):  # a gap inside a bisected interval
+            unreached = next(i for i, c in enumerate(configurations) if c is None)
+            continue
+        return np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations])
+    raise MotionError(
+        f"at sample {unreached} the soles are out of the legs' reach at every root height from "
+        f"{MAX_PROFILE_RISE:g} m higher to {MAX_DIP:g} m lower"
+    )
+
+
+def reach_interval(
+    talos,
+    q: np.ndarray,
+    feet: np.ndarray,
+    rotation: np.ndarray,
+    shift: np.ndarray,
+    knees: np.ndarray,
+    margin: float = 0.0,
+) -> tuple[float, float]:
+    """Lowest and highest lowering (m, within 1e-5; negative: a rise) of q's root, moved
+    horizontally by shift [2] and turned to rotation [3, 3], for which `held_root_configuration`
+    places both soles at feet [2, 4, 4] (knees [2], margin: as there); within MAX_PROFILE_RISE
+    up and MAX_DIP down; (NaN, NaN) when none does.
+
+    The lowerings that work form an interval (`root_dip`): a DIP_SCAN scan finds the first run
+    of them, bisection both its ends.
+    """
+
+    def works(dip: float) -> bool:
+        offset = np.r_[shift, -dip]
+        return held_root_configuration(talos, q, feet, rotation, offset, knees, margin) is not None
+
+    scan = np.arange(-round(MAX_PROFILE_RISE / DIP_SCAN), round(MAX_DIP / DIP_SCAN) + 1) * DIP_SCAN
+    good = np.array([works(d) for d in scan])
+    if not good.any():
+        return float("nan"), float("nan")
+    first = int(np.argmax(good))
+    last = first + int(np.argmin(np.r_[good[first:], False])) - 1
+
+    def edge(inside: float, outside: float) -> float:
+        while abs(outside - inside) > 1e-5:
+            middle = 0.5 * (inside + outside)
+            inside, outside = (middle, outside) if works(middle) else (inside, middle)
+        return inside
+
+    low = scan[first] if first == 0 else edge(scan[first], scan[first - 1])
+    high = scan[last] if last == len(scan) - 1 else edge(scan[last], scan[last + 1])
+    return float(low), float(high)
+
+
+def dip_profile(low: np.ndarray, high: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Root lowerings [M] (m) of a single-support phase's samples, each inside [low_i, high_i]
+    ([M] each, m; negative: a rise), with the least squared third differences (the least jerk:
+    the acceleration grows from 0 where the root leaves its rest; a tiny pull towards 0 breaks
+    ties) by bounded least squares.
+
+    The bounds are narrowed by DIP_INSET on each side where they leave room (their middle
+    where they do not); samples of contact weight [M] (`contact_weight`) under 1e-3, around
+    the key posture, keep the root (0, which must be inside their bounds), and the three
+    samples at the contact end are held level: the root starts and ends the phase at rest.
+    """
+    from scipy.optimize import lsq_linear
+
+    room = np.minimum(DIP_INSET, 0.5 * (high - low))
+    lower, upper = low + room, high - room
+    key = weight < 1e-3
+    lower[key], upper[key] = -1e-12, 1e-12
+    m = len(weight)
+    third = np.zeros((m - 3, m))
+    for offset, value in enumerate((-1.0, 3.0, -3.0, 1.0)):
+        third[np.arange(m - 3), np.arange(m - 3) + offset] = value
+    # rest at the contact end too (the shift around the phase starts or ends there at rest):
+    # its last three samples' lowering equal, weighted far above the jerk
+    rest = np.zeros((2, m))
+    end = m - 3 if weight[-1] > weight[0] else 0
+    rest[0, end : end + 2] = rest[1, end + 1 : end + 3] = (1e3, -1e3)
+    system = np.vstack([third, rest, 1e-7 * np.eye(m)])
+    result = lsq_linear(system, np.zeros(len(system)), bounds=(lower, upper), method="bvls")
+    return np.clip(result.x, low, high)
+
+
 def support_margin(points: np.ndarray, point: np.ndarray) -> float:
     """Signed distance, m, of point [2] inside the convex hull of points [P, 2] (negative outside)."""
     from scipy.spatial import ConvexHull
@@ -713,51 +848,61 @@ def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tu
     from leas_jax.motion.paths import shift_duration
 
     limit, dt = config.single_support_acceleration, config.dt
-    coms = _single_support_coms(talos, spec, k, config)
+    coms, profiled = _single_support_coms(talos, spec, k, config)
     for _ in range(STRETCHES):
         distance = float(np.linalg.norm(coms[-1] - coms[0]))
         seconds = shift_duration(distance, limit, spec.samples * dt, dt)
-        samples = max(round(seconds / dt), stretched_samples(coms, spec.samples, limit, dt))
+        samples = max(
+            round(seconds / dt), stretched_samples(coms, spec.samples, limit, dt, vertical=profiled)
+        )
         if samples <= spec.samples:
             break
         spec = dataclasses.replace(spec, samples=samples)
-        coms = _single_support_coms(talos, spec, k, config)
+        coms, profiled = _single_support_coms(talos, spec, k, config)
     return spec, coms
 
 
-def peak_horizontal_acceleration(points: np.ndarray, dt: float) -> float:
+def peak_horizontal_acceleration(points: np.ndarray, dt: float, vertical: bool = False) -> float:
     """Largest horizontal acceleration, m/s^2, of points [M, 3] (world, m) sampled every dt s,
-    by second differences (0 under 3 samples)."""
+    by second differences (0 under 3 samples); vertical: of all three coordinates."""
     if len(points) < 3:
         return 0.0
-    second = (points[2:, :2] - 2.0 * points[1:-1, :2] + points[:-2, :2]) / dt**2
+    axes = 3 if vertical else 2
+    second = (points[2:, :axes] - 2.0 * points[1:-1, :axes] + points[:-2, :axes]) / dt**2
     return float(np.linalg.norm(second, axis=1).max())
 
 
-def stretched_samples(points: np.ndarray, samples: int, limit: float, dt: float) -> int:
+def stretched_samples(
+    points: np.ndarray, samples: int, limit: float, dt: float, vertical: bool = False
+) -> int:
     """Samples (at least `samples`) of a phase whose path points [samples + 1, 3] (world, m; a
-    function of normalised time) keeps its peak horizontal acceleration within `limit`, m/s^2,
-    when played over them: accelerations scale with the inverse square of the duration."""
-    peak = peak_horizontal_acceleration(points, dt)
+    function of normalised time) keeps its peak horizontal acceleration (vertical: of all three
+    coordinates) within `limit`, m/s^2, when played over them: accelerations scale with the
+    inverse square of the duration."""
+    peak = peak_horizontal_acceleration(points, dt, vertical)
     if peak <= limit:
         return samples
     return max(samples, math.ceil(samples * math.sqrt(peak / limit) - 1e-9))
 
 
-def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> np.ndarray:
-    """`single_support_coms` [n + 1, 3] of a lift or land spec's samples 0..n (MotionError
-    naming postures k and k + 1)."""
+def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[np.ndarray, bool]:
+    """`single_support_coms` [n + 1, 3] of a lift or land spec's samples 0..n, else
+    `profiled_single_support_coms`, and whether the latter made them (MotionError naming
+    postures k and k + 1 and the first's reason)."""
     from leas_jax.motion.paths import slerp
 
     fractions = np.arange(spec.samples + 1) / spec.samples
     feet = swing_feet(spec, fractions)
     rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
+    arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config)
     try:
-        return single_support_coms(
-            talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config
-        )
+        return single_support_coms(*arguments), False
     except MotionError as exc:
-        raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {exc}") from None
+        held = exc
+    try:
+        return profiled_single_support_coms(*arguments), True
+    except MotionError:
+        raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {held}") from None
 
 
 def turn_scaling(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:

@@ -99,3 +99,27 @@ def test_a_profiled_phase_is_stretched_for_its_vertical_acceleration_too():
     assert stretched_samples(path, samples, 0.5, dt) == samples
     longer = stretched_samples(path, samples, 0.5, dt, vertical=True)
     assert 190 < longer < 210
+
+
+def test_reach_intervals_stop_at_the_first_sample_found_out_of_reach(monkeypatch):
+    """Every tenth sample is searched first and the search stops where the soles are out of
+    reach: a phase that cannot be made costs a tenth of the searches; one that can, all of them
+    in any order, each sample its own interval."""
+    import leas_jax.motion.motion as motion
+
+    searched = []
+
+    def interval(talos, q, feet, rotation, shift, knees, margin):
+        searched.append(int(feet))
+        return (np.nan, np.nan) if feet == 30 else (-0.01 * feet, 0.01 * feet)
+
+    monkeypatch.setattr(motion, "reach_interval", interval)
+    samples = np.arange(100)
+    low, high, out = motion.reach_intervals(None, None, samples, samples, samples, samples, 0.0)
+    assert out == 30 and searched == [0, 10, 20, 30]
+    searched.clear()
+    samples = np.arange(25)
+    low, high, out = motion.reach_intervals(None, None, samples, samples, samples, samples, 0.0)
+    assert out is None and sorted(searched) == list(range(25))
+    np.testing.assert_allclose(high, 0.01 * samples)
+    np.testing.assert_allclose(low, -0.01 * samples)

@@ -464,6 +464,23 @@ def dip_depth(needs: np.ndarray, weight: np.ndarray) -> float:
     return float(np.max(needs[positive] / weight[positive]))
 
 
+def single_support_schedule(talos, q: np.ndarray, feet: np.ndarray, swing: int, lifting: bool, config):
+    """What a single-support phase's samples share: (contact weight [M], least knee bends
+    [M, 2] (rad; the key posture's bend where under `config.min_knee`, eased to it as the
+    weight falls), the unit horizontal direction [2] along the stance sole towards the swing
+    sole at contact, world).
+
+    Arguments as `single_support_coms`.
+    """
+    weight = contact_weight(len(feet), lifting)
+    bent = np.array([q[leg.q_index[3]] for leg in talos.legs])
+    knees = config.min_knee - np.maximum(config.min_knee - bent, 0.0) * (1.0 - weight[:, None])  # [M, 2]
+    contact = feet[0 if lifting else -1]
+    ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
+    toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
+    return weight, knees, toward
+
+
 def single_support_coms(
     talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
 ) -> np.ndarray:
@@ -498,12 +515,7 @@ def single_support_coms(
 
     from leas_jax.motion.paths import lerp, min_jerk
 
-    weight = contact_weight(len(feet), lifting)
-    bent = np.array([q[leg.q_index[3]] for leg in talos.legs])
-    knees = config.min_knee - np.maximum(config.min_knee - bent, 0.0) * (1.0 - weight[:, None])  # [M, 2]
-    contact = feet[0 if lifting else -1]
-    ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
-    toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
+    weight, knees, toward = single_support_schedule(talos, q, feet, swing, lifting, config)
     data = talos.model.createData()
 
     def attempt(margin: float) -> np.ndarray:
@@ -580,12 +592,7 @@ def profiled_single_support_coms(
 
     if not config.profiled_reach:
         raise MotionError("the root's height is not chosen sample by sample (MotionConfig.profiled_reach)")
-    weight = contact_weight(len(feet), lifting)
-    bent = np.array([q[leg.q_index[3]] for leg in talos.legs])
-    knees = config.min_knee - np.maximum(config.min_knee - bent, 0.0) * (1.0 - weight[:, None])  # [M, 2]
-    contact = feet[0 if lifting else -1]
-    ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
-    toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
+    weight, knees, toward = single_support_schedule(talos, q, feet, swing, lifting, config)
     data = talos.model.createData()
     lean = config.lean * weight[:, None] * toward
     unreached = 0

@@ -68,10 +68,12 @@ def c_stdout_discarded():
     Planning (`contacts.validation.runner.PathRunner.run`) and `contacts.verify` run their LPs
     inside it. (Not in `HppEquilibrium` itself: the generator's code is in the key of its
     labels, `feasibility.spawns.GENERATOR_SOURCES`, and an edit there makes them stale.)
-    Python's own buffered output is not lost (it reaches the descriptor after the block). About
-    4 us a block, 1-2 % of one LP."""
+    What Python printed before the block is flushed first; what it prints inside stays in
+    sys.stdout's buffer and reaches the descriptor after the block. About 4 us a block, 1-2 % of
+    one LP."""
     if not _DEVNULL:
         _DEVNULL.append(os.open(os.devnull, os.O_WRONLY))
+    sys.stdout.flush()  # what Python printed before the block reaches stdout, not the void
     saved = os.dup(1)
     try:
         os.dup2(_DEVNULL[0], 1)

@@ -59,3 +59,19 @@ def test_compiled_code_writes_on_stdout_are_discarded_inside_the_block_only():
     done = _python("-c", code)
     assert done.returncode == 0, done.stderr
     assert done.stdout == "before\nafter\nprinted\n"
+
+
+def test_what_python_printed_before_the_block_is_not_discarded():
+    """A print before the block still sits in sys.stdout's buffer (stdout is a pipe here); the
+    block flushes it before discarding descriptor 1, so it reaches stdout, in order."""
+    code = (
+        "import os\n"
+        "from leas_jax.quiet import c_stdout_discarded\n"
+        "print('printed before')\n"
+        "with c_stdout_discarded():\n"
+        "    os.write(1, b'[DEBUG] inside\\n')\n"
+        "os.write(1, b'after\\n')\n"
+    )
+    done = _python("-c", code)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "printed before\nafter\n"

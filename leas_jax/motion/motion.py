@@ -918,7 +918,7 @@ def stretched_samples(
 def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[np.ndarray, bool]:
     """`single_support_coms` [n + 1, 3] of a lift or land spec's samples 0..n, else
     `profiled_single_support_coms`, and whether the latter made them (MotionError naming
-    postures k and k + 1 and the first's reason)."""
+    postures k and k + 1 and both reasons)."""
     from leas_jax.motion.paths import slerp
 
     fractions = np.arange(spec.samples + 1) / spec.samples
@@ -931,8 +931,8 @@ def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) 
         held = exc
     try:
         return profiled_single_support_coms(*arguments), True
-    except MotionError:
-        raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {held}") from None
+    except MotionError as exc:
+        raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {held}; sample by sample: {exc}") from None
 
 
 def turn_scaling(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:

@@ -151,3 +151,4 @@ def test_the_run_report_breaks_its_invalid_episodes_down(run_dir, tmp_path):
     invalid = round((1 - results["arena_valid_fraction"]) * 16)
     assert (f"{invalid} episodes. Failed terms:" in line) if invalid else line.endswith("none.")
     assert (tmp_path / "rollouts_arena.png").is_file()
+    assert (tmp_path / "learning_curves.png").stat().st_size > 0  # the run's metrics, on its own canvas

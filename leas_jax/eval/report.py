@@ -27,20 +27,17 @@ def plot_curves(
     color: str = "tab:blue",
 ) -> None:
     """PNG with one panel per (metric key, title) against env steps."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from leas_jax.plotting import agg_figure
 
     steps = np.array([r["env_steps"] for r in records], dtype=float) / steps_scale
-    figure, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.2), layout="constrained")
+    figure = agg_figure(4 * len(panels), 3.2, layout="constrained")
+    axes = figure.subplots(1, len(panels))
     for ax, (key, label) in zip(axes, panels):
         ax.plot(steps, np.array([r.get(key, np.nan) for r in records], dtype=float), color=color)
         ax.set_xlabel(steps_label)
         ax.set_title(label, fontsize=10)
         ax.grid(alpha=0.3)
     figure.savefig(path, dpi=110)
-    plt.close(figure)
 
 
 GEOMETRIC_PANELS = [

@@ -18,7 +18,7 @@ from navigate_helpers import plan_until
 from leas_jax.contacts.validation.pool import ValidationPool
 from leas_jax.navigate import result as reasons
 from leas_jax.navigate.lattice import build_lattice, heading_index
-from leas_jax.navigate.loop import NavigateConfig, Navigator, stall_start
+from leas_jax.navigate.loop import NavigateConfig, Navigator, path_guide, stall_start
 from leas_jax.navigate.search import search
 from leas_jax.terrain import load_terrain, loads_terrain
 
@@ -134,7 +134,7 @@ def _run(policy, terrain, queries, workers=0, **config):
 def test_replans_around_an_injected_generator_failure(policy):
     (result,) = _run(policy, loads_terrain(SLAB), [((1.0, 2.0, 0.0), (5.0, 2.0))])
     assert result.success and result.reason == reasons.REACHED, result.message
-    assert result.replans >= 1 and len(result.attempts) == result.replans + 1
+    assert result.replans >= 1 and sum(a.kind == "policy" for a in result.attempts) == result.replans + 1
     first = result.attempts[0]
     assert first.last_valid_index < first.guide_length - 1
     assert np.hypot(*(np.array(first.failure) - BLOCK)) < BLOCK_RADIUS + 0.2
@@ -187,10 +187,62 @@ def test_a_stalled_rollout_is_cut_and_searched_round(policy, monkeypatch):
 
 
 def test_without_replans_the_injected_failure_ends_the_query(policy):
-    (result,) = _run(policy, loads_terrain(SLAB), [((1.0, 2.0, 0.0), (5.0, 2.0))], max_replans=0)
+    (result,) = _run(
+        policy, loads_terrain(SLAB), [((1.0, 2.0, 0.0), (5.0, 2.0))], max_replans=0, path_fallback=False
+    )
     assert not result.success and result.reason == reasons.REPLAN_LIMIT
     assert result.replans == 0 and "after 0 replans" in result.message
     assert result.plan is not None and result.final_distance > 1.5
+    # with the searched path tried once more (not counted as a replan): it meets the block too
+    (result,) = _run(policy, loads_terrain(SLAB), [((1.0, 2.0, 0.0), (5.0, 2.0))], max_replans=0)
+    assert not result.success and "after 0 replans" in result.message
+    assert [a.kind for a in result.attempts] == ["policy", "path"]
+    assert result.attempts[1].failure is not None and result.final_distance > 1.5
+
+
+def test_path_guide_walks_the_searched_path_at_the_speed():
+    """From the pose (its x, y, yaw first) through the path's later nodes, a pose every
+    speed x timestep metres of arc, the path's end last; the yaw turns the short way across +-pi."""
+    pose = np.array([0.0, 0.0, 1.0, 3.1])
+    path = np.array([[0.01, 0.0, 3.1], [0.5, 0.0, -3.1], [1.0, 0.0, -3.0]])
+    guide = path_guide(pose, path, speed=0.1, timestep=0.1)
+    np.testing.assert_allclose(guide[0], pose[[0, 1, 3]])
+    np.testing.assert_allclose(guide[-1, :2], path[-1, :2])
+    steps = np.hypot(*np.diff(guide[:, :2], axis=0).T)
+    np.testing.assert_allclose(steps[:-1], 0.01, atol=1e-12)
+    assert 0.0 < steps[-1] <= 0.01 + 1e-12
+    assert np.all(np.diff(guide[:, 2]) >= 0.0) and guide[-1, 2] == pytest.approx(2 * np.pi - 3.0)
+
+
+def test_where_the_policy_wavers_the_searched_path_is_walked(policy, monkeypatch):
+    """A stand-in generator that stops a guide where it strays 0.1 m from the line y = 2 (a beam)
+    and a policy that drifts off it: the searched path along y = 2 is walked next from the
+    verified pose before the failure, unpenalised, and reaches; LeaS alone never would."""
+    real = Navigator._rollout
+
+    def wavers(self, poses, speeds, waypoints):  # drifts off y = 2 past x = 2
+        guides = real(self, poses, speeds, waypoints)
+        return [
+            g + np.c_[0 * g[:, :1], 0.3 * np.clip(g[:, :1] - 2.0, 0.0, None), 0 * g[:, 2:]] for g in guides
+        ]
+
+    def beam(terrain, guide, timestep, config):
+        off = np.flatnonzero(np.abs(guide[:, 1] - 2.0) > 0.1)
+        return plan_until(guide, len(guide) - 1 if len(off) == 0 else max(int(off[0]) - 1, 0))
+
+    monkeypatch.setattr(Navigator, "_rollout", wavers)
+    answers = {}
+    for fallback in (False, True):
+        navigator = Navigator(
+            policy, loads_terrain(SLAB), NavigateConfig(max_replans=1, path_fallback=fallback)
+        )
+        with ValidationPool(navigator.terrain, workers=0, plan_fn=beam, return_plans=True) as pool:
+            (answers[fallback],) = navigator.run([navigator.query((1.0, 2.0, 0.0), (5.0, 2.0))], pool=pool)
+    assert not answers[False].success and answers[False].reason == reasons.REPLAN_LIMIT
+    result = answers[True]
+    assert result.success, result.message
+    assert [a.kind for a in result.attempts] == ["policy", "path"]
+    assert result.attempts[1].begin > 0 and np.abs(result.guide[:, 1] - 2.0).max() <= 0.1
 
 
 def test_unreachable_goals_end_with_the_partial_plan_and_the_reason(policy):

@@ -152,3 +152,26 @@ def test_the_real_generator_gives_the_same_plans_with_1_and_2_workers(tmp_path):
         assert a.reason == b.reason and a.replans == b.replans
         np.testing.assert_array_equal(a.plan.q, b.plan.q)
         np.testing.assert_array_equal(a.guide, b.guide)
+
+
+def test_policy_only_turns_the_searched_paths_fallback_off():
+    """`leas navigate --policy-only` and `leas evaluate --navigate-policy-only` give the loop a
+    NavigateConfig without the fallback; without them it is on (the default)."""
+    import argparse
+
+    from leas_jax.eval.commands import _navigate_config
+    from leas_jax.eval.commands import register as register_evaluate
+    from leas_jax.navigate.commands import navigate_config
+    from leas_jax.navigate.commands import register as register_navigate
+
+    parser = argparse.ArgumentParser()
+    commands = parser.add_subparsers()
+    register_navigate(commands)
+    register_evaluate(commands)
+    base = ["navigate", "--checkpoint", SHIPPED, "--terrain", WALL, "--start", "1,1,0", "--goal", "2,1"]
+    base += ["--out", "plan.npz"]
+    assert navigate_config(parser.parse_args(base)).path_fallback
+    assert not navigate_config(parser.parse_args([*base, "--policy-only"])).path_fallback
+    evaluate = ["evaluate", "--scenario", "bridge", "--methods", "navigate", "--out", "o"]
+    assert _navigate_config(parser.parse_args(evaluate)) is None  # NavigateConfig's defaults
+    assert not _navigate_config(parser.parse_args([*evaluate, "--navigate-policy-only"])).path_fallback

@@ -186,8 +186,9 @@ def _add_run_arguments(parser, methods_default: str, starts_per: str, workers_mo
 
 
 def _navigate_config(args):
-    """The navigate method's `NavigateConfig`: its defaults, with the walkability model given."""
-    if args.navigate_walkability is None:
+    """The navigate method's `NavigateConfig`: its defaults, with the walkability model given and
+    the searched path's fallback off where asked."""
+    if args.navigate_walkability is None and not args.navigate_policy_only:
         return None
     import dataclasses
 
@@ -195,7 +196,9 @@ def _navigate_config(args):
 
     config = NavigateConfig()
     return dataclasses.replace(
-        config, lattice=dataclasses.replace(config.lattice, walkability=args.navigate_walkability)
+        config,
+        path_fallback=not args.navigate_policy_only,
+        lattice=dataclasses.replace(config.lattice, walkability=args.navigate_walkability),
     )
 
 
@@ -245,6 +248,12 @@ def register(subparsers) -> None:
         default=None,
         help="the navigate method's lattice judges confident ground with this walkability model "
         "(`leas feasibility walkability`; default: the policy's reachability condition)",
+    )
+    parser.add_argument(
+        "--navigate-policy-only",
+        action="store_true",
+        help="the navigate method's policy walks every search (default: where the generator stops on "
+        "the policy's guide, the searched path itself is walked first)",
     )
     parser.add_argument(
         "--motion",

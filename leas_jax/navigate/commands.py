@@ -48,6 +48,7 @@ def navigate_config(args):
     return dataclasses.replace(
         config,
         max_replans=config.max_replans if args.max_replans is None else args.max_replans,
+        path_fallback=not args.policy_only,
         lattice=dataclasses.replace(
             config.lattice,
             resolution=args.resolution,
@@ -55,6 +56,12 @@ def navigate_config(args):
             walkability=args.walkability,
         ),
     )
+
+
+def _path_walks(result) -> str:
+    """ ", N along the searched path" for the attempts whose searched path was walked itself, or ""."""
+    walks = sum(attempt.kind == "path" for attempt in result.attempts)
+    return f", {walks} along the searched path" if walks else ""
 
 
 def cmd_navigate(args) -> int:
@@ -106,7 +113,7 @@ def cmd_navigate(args) -> int:
     else:
         print(
             f"{out}: {len(result.plan)} postures, coverage {result.plan.coverage:.3f}, "
-            f"final distance {result.final_distance:.2f} m, {result.replans} replans"
+            f"final distance {result.final_distance:.2f} m, {result.replans} replans{_path_walks(result)}"
         )
     print(f"time {seconds['total']:.2f} s ({split})")
     if html is not None and result.plan is not None:
@@ -169,7 +176,17 @@ def register(subparsers) -> None:
         "--workers", type=int, default=1, help="contact-generator processes (0: in this process; default 1)"
     )
     parser.add_argument(
-        "--max-replans", type=int, default=None, help="searches after the first (default 5, NavigateConfig)"
+        "--max-replans",
+        type=int,
+        default=None,
+        help="searches after the first that the policy walks (default 5, NavigateConfig; a searched "
+        "path walked itself where the generator stopped on the policy's guide is not counted)",
+    )
+    parser.add_argument(
+        "--policy-only",
+        action="store_true",
+        help="the policy walks every search (default: where the generator stops on the policy's guide, "
+        "the searched path itself is walked first)",
     )
     parser.add_argument("--resolution", type=float, default=0.05, help="lattice cell size, m (default 0.05)")
     parser.add_argument(

@@ -10,9 +10,12 @@ One query runs, in a closed loop with the contact generator:
    stall counts as a failure there (step 4);
 3. contact planning: the generator validates the whole guide grown so far (the verified
    prefix of the previous attempts plus the new segment; one `ValidationPool` task);
-4. where it stops short, the cells within `failure_radius` of where it failed are penalised,
-   and the search is repeated from a verified pose `backoff_distance` before its last valid
-   posture, at most `max_replans` times.
+4. where it stops short on the policy's guide, the searched path itself is walked from a
+   verified pose `backoff_distance` before its last valid posture (`path_guide`, unless
+   `path_fallback` is off); where it stops short on that (or on a policy guide without the
+   fallback), the cells within `failure_radius` of where it failed are penalised, and the
+   search is repeated from such a verified pose for the policy to walk, at most `max_replans`
+   times.
 
 The lattice offers doubtful ground (plausible, not confident: `lattice`) at a cost; the
 generator's verdicts are what the loop learns from, kept across the replans of a query: the
@@ -52,7 +55,8 @@ class NavigateConfig:
 
     lattice: LatticeConfig = LatticeConfig()
     search: SearchConfig = SearchConfig()
-    # searches after the first one. 5: on the HPP rough scenes (20 starts each,
+    # searches after the first one that the policy walks (those whose path is walked itself,
+    # `path_fallback`, are not counted). 5: on the HPP rough scenes (20 starts each,
     # docs/results/2026-12-06-rough-scenes) every query that failed with 3 had used all 3 (the
     # generator stops on rubble, another way round is tried); a query that reaches needs 0-2.
     max_replans: int = 5
@@ -85,6 +89,15 @@ class NavigateConfig:
     # policy's 0.35 rad/s takes about 4.5 s. stall_time None: never.
     stall_time: float | None = 5.0
     stall_radius: float = 0.25
+    # Where the generator stops on the policy's guide, the next attempt first walks the searched
+    # lattice path itself from the same verified pose (`path_guide`: its cells' positions and
+    # headings at the env's target speed, on the terrain), before the failed region is penalised
+    # and searched round: a policy that wavers off a narrow beam loses the crossing that the
+    # path along the beam's valid cells keeps (eval_bridge with the `quick` preset's 30 M
+    # policies, docs/results/2026-12-06-navigate-path-fallback). Such an attempt does not count
+    # against max_replans; where it fails too, its failure is penalised and the policy walks
+    # the next search. False: the policy walks every search.
+    path_fallback: bool = True
     generator: object = None  # `GeneratorConfig` of the contact generator (None: its defaults)
 
 
@@ -120,6 +133,7 @@ class _State:
     path: np.ndarray | None = None
     waypoints: np.ndarray | None = None
     stalled: bool = False  # the guide's last segment was cut where the policy stalled (`stall_start`)
+    kind: str = "policy"  # what walked the guide's last segment: "policy" or "path" (`path_guide`)
     attempts: list = field(default_factory=list)
     best: tuple | None = None  # (final distance, plan, guide)
     unreachable: str | None = None  # the first search reason that the goal cannot be reached
@@ -152,6 +166,26 @@ def _ahead(pose: np.ndarray, config: NavigateConfig) -> np.ndarray:
     """[2] world centre of the disk penalised after a failure at guide pose [4] (x, y, z, yaw):
     `failure_radius` / 2 ahead of it along its heading."""
     return pose[:2] + 0.5 * config.failure_radius * np.array([math.cos(pose[3]), math.sin(pose[3])])
+
+
+def path_guide(pose: np.ndarray, path: np.ndarray, speed: float, timestep: float) -> np.ndarray:
+    """Planar guide along a lattice path, walked at a constant speed.
+
+    Args:
+        pose: [4] (x, y, z, yaw) world, where the guide starts (its first pose is this one's
+            x, y, yaw).
+        path: [N, 3] (x, y, yaw) world, the search's path from the node nearest `pose`.
+        speed: m/s along the path; timestep: s between guide poses.
+
+    Returns:
+        [T, 3] (x, y, yaw) world: positions by arc length from the pose through path[1:], yaw
+        interpolated likewise (unwrapped from the pose's), the path's end last.
+    """
+    points = np.concatenate([np.asarray(pose, np.float64)[None, [0, 1, 3]], np.asarray(path, np.float64)[1:]])
+    points[:, 2] = np.unwrap(points[:, 2])
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points[:, :2], axis=0).T))])
+    at = np.append(np.arange(0.0, arc[-1], speed * timestep), arc[-1])
+    return np.stack([np.interp(at, arc, points[:, k]) for k in range(3)], axis=-1)
 
 
 def _fmt(xy) -> str:
@@ -444,6 +478,7 @@ class Navigator:
                 float(result.coverage),
                 None if failure is None else (float(failure[0]), float(failure[1])),
                 state.search.reason,
+                state.kind,
             )
         )
         self.say(
@@ -461,7 +496,9 @@ class Navigator:
             )
         if last >= total - 1 and state.search.reason is not None:
             return self._finish(state, state.search.reason, self._unreachable_text(state), k)
-        if len(state.attempts) > cfg.max_replans:
+        # the generator stopped on the policy's guide: its searched path is walked next, unpenalised
+        fallback = cfg.path_fallback and failure is not None and not policy_stalled and state.kind == "policy"
+        if sum(a.kind == "policy" for a in state.attempts) > cfg.max_replans and not fallback:
             if state.unreachable is not None:
                 return self._finish(state, state.unreachable, self._unreachable_text(state), k)
             where = guide[-1, :2] if failure is None else failure
@@ -474,13 +511,14 @@ class Navigator:
             )
         if failure is None:  # the whole guide is verified: walk on from its end
             begin = total - 1
-        else:  # penalise the failed region, search again from a verified pose before it
-            cells = self.lattice.position(
-                np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
-            )
-            state.penalty += cfg.failure_penalty * (
-                np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
-            )
+        else:  # penalise the failed region (unless the path is tried first), search again before it
+            if not fallback:
+                cells = self.lattice.position(
+                    np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
+                )
+                state.penalty += cfg.failure_penalty * (
+                    np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
+                )
             walked = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(guide[: last + 1, :2], axis=0).T))])
             begin = int(np.searchsorted(walked, walked[-1] - cfg.backoff_distance, side="right")) - 1
             begin = max(0, begin)
@@ -491,6 +529,8 @@ class Navigator:
             else query.speed
         )
         avoid = "walking on" if failure is None else f"avoiding {_fmt(failure)}"
+        if fallback:
+            avoid = f"along the searched path through {_fmt(failure)}"
         if policy_stalled:
             avoid += " (the policy stalled there)"
         self.say(f"query {k}: replan {len(state.attempts)} from guide pose {begin} {_fmt(pose[:2])}, {avoid}")
@@ -507,12 +547,28 @@ class Navigator:
         state.seconds["search"] += time.perf_counter() - began
         self._said_search(k, state)
         began = time.perf_counter()
-        (segment,) = self._rollout(pose[None], np.array([speed]), [state.search.waypoints])
+        if fallback:
+            segment = self._path_segment(pose, state.search.path)
+            state.stalled = False
+        else:
+            (rollout,) = self._rollout(pose[None], np.array([speed]), [state.search.waypoints])
+            segment = self._cut_stall(k, state, rollout)
         state.seconds["rollout"] += time.perf_counter() - began
+        state.kind = "path" if fallback else "policy"
         state.path, state.waypoints = state.search.path, state.search.waypoints
-        state.guide = np.concatenate([guide[:begin], self._cut_stall(k, state, segment)])
+        state.guide = np.concatenate([guide[:begin], segment])
         state.segment_begin = begin
         return state.guide
+
+    def _path_segment(self, pose: np.ndarray, path: np.ndarray) -> np.ndarray:
+        """Guide segment [T, 4] from a verified guide pose [4] (kept as it is, first) along a
+        searched path [N, 3] (`path_guide`), the root at the nominal height above the terrain."""
+        from leas_jax.steering.baselines import lift
+
+        planar = path_guide(pose, path, self.env.target_speed, self.env.timestep)
+        segment = lift(self.field, planar, self.env.nominal_root_height)
+        segment[0] = pose
+        return segment
 
     def _cut_stall(self, k: int, state: _State, segment: np.ndarray) -> np.ndarray:
         """A new rollout segment [T, 4], cut after the pose where the policy stalled
@@ -574,7 +630,7 @@ class Navigator:
             guide=guide,
             waypoints=state.waypoints,
             path=state.path,
-            replans=len(state.attempts) - 1,
+            replans=sum(a.kind == "policy" for a in state.attempts) - 1,
             attempts=tuple(state.attempts),
             final_distance=float(distance),
             seconds=dict(state.seconds),

@@ -24,8 +24,11 @@ class Attempt:
         guide_length: poses of the whole guide it produced.
         last_valid_index: the contact generator's answer on that guide (-1: none).
         coverage: its coverage.
-        failure: (x, y) world of the region penalised after it, or None.
+        failure: (x, y) world of where the generator stopped (penalised after it unless the
+            searched path is walked through it next), or None.
         search_reason: the search's reason it did not reach the goal, or None.
+        kind: what walked its segment: "policy" (the LeaS rollout) or "path" (the searched
+            lattice path itself, `loop.path_guide`, after the generator stopped on the policy's).
     """
 
     begin: int
@@ -34,6 +37,7 @@ class Attempt:
     coverage: float
     failure: tuple[float, float] | None
     search_reason: str | None
+    kind: str = "policy"
 
 
 @dataclass(frozen=True)
@@ -51,7 +55,8 @@ class NavigationResult:
         waypoints: [W, 2] world, the points the policy followed last (the search's path,
             every `waypoint_spacing`).
         path: [P, 3] (x, y, yaw) world, the last lattice path.
-        replans: searches after the first.
+        replans: searches after the first that the policy walked (what `max_replans` bounds;
+            `attempts` holds those whose path was walked itself too).
         attempts: every `Attempt`, in order.
         final_distance: m from the plan's nearest posture root to the goal (nan: no plan).
         seconds: wall time per part: lattice, search, rollout, contact_planning, total.

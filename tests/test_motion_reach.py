@@ -123,3 +123,19 @@ def test_reach_intervals_stop_at_the_first_sample_found_out_of_reach(monkeypatch
     assert out is None and sorted(searched) == list(range(25))
     np.testing.assert_allclose(high, 0.01 * samples)
     np.testing.assert_allclose(low, -0.01 * samples)
+
+
+def test_a_bound_through_the_key_posture_leaves_it_without_a_step():
+    """A landing whose key posture has its legs at their reach: the highest lowering that reaches
+    falls through 0 just after the key posture's samples. The profile leaves them smoothly, and
+    a longer phase has it gentler (what lengthening a phase for its acceleration relies on); a
+    full 5 mm inset there forced a step at any duration."""
+    peaks = []
+    for samples in (81, 321):
+        weight = contact_weight(samples, lifting=False)
+        t = np.linspace(0.0, 1.0, samples)
+        high = 0.004 - 0.05 * t  # the root must rise after t = 0.08
+        dips = dip_profile(np.full(samples, -0.3), high, weight)
+        assert np.all(dips <= high + 1e-9) and np.all(np.abs(dips[weight < 1e-3]) < 1e-9)
+        peaks.append(np.abs(np.diff(dips, 2)).max())
+    assert peaks[0] < 1e-3 and peaks[1] < 0.5 * peaks[0], peaks

@@ -81,9 +81,13 @@ MAX_PROFILE_RISE = 0.3
 # that works (else none), rad: the whole-body IK tracks their CoM, not their root, and ends
 # a few mrad off them (measured on eval_bridge's crouched plans: an ankle 0.1 mrad past).
 LIMIT_MARGIN = 0.03
-# A root height chosen sample by sample (`dip_profile`) keeps this far, m, inside what reaches
-# where there is room: its smoothing then stays off the corners of those bounds (a corner
-# followed exactly gave rubble_0's landing 75 -> 76 a 12 m/s^2 vertical CoM acceleration).
+# A root height chosen sample by sample (`dip_profile`) keeps up to this far, m, inside what
+# reaches where there is room: its smoothing then stays off the corners of those bounds (a
+# corner followed exactly gave rubble_0's landing 75 -> 76 a 12 m/s^2 vertical CoM
+# acceleration). The inset is this times the contact weight, 0 at the key posture: where a bound
+# passes through the key posture's root (legs stretched to their reach), a full inset forced a
+# 5 mm step at the first sample off it, 50 m/s^2 at any duration, so that lengthening the phase
+# for its acceleration never ended (rubble_1's lift 140 -> 141: 554 -> 5 080 samples).
 DIP_INSET = 0.005
 # A single-support phase is lengthened at most this many times for its CoM's acceleration
 # (`_single_support`; one is enough where its references scale with its duration, the next
@@ -689,14 +693,14 @@ def dip_profile(low: np.ndarray, high: np.ndarray, weight: np.ndarray) -> np.nda
     the acceleration grows from 0 where the root leaves its rest; a tiny pull towards 0 breaks
     ties) by bounded least squares.
 
-    The bounds are narrowed by DIP_INSET on each side where they leave room (their middle
-    where they do not); samples of contact weight [M] (`contact_weight`) under 1e-3, around
+    The bounds are narrowed by DIP_INSET x the contact weight on each side where they leave
+    room (their middle where they do not); samples of contact weight [M] (`contact_weight`) under 1e-3, around
     the key posture, keep the root (0, which must be inside their bounds), and the three
     samples at the contact end are held level: the root starts and ends the phase at rest.
     """
     from scipy.optimize import lsq_linear
 
-    room = np.minimum(DIP_INSET, 0.5 * (high - low))
+    room = np.minimum(DIP_INSET * weight, 0.5 * (high - low))
     lower, upper = low + room, high - room
     key = weight < 1e-3
     lower[key], upper[key] = -1e-12, 1e-12

@@ -41,6 +41,9 @@ for stage in $STAGES; do
       .venv/bin/python studies/navigate_demos.py --workers 1 --out /tmp/path_fallback/demos | tee "$HERE/demos.txt"
       .venv/bin/leas evaluate --scenario hole,bridge,stairs,stairs_side,circuit --methods navigate \
         --checkpoint checkpoints/leas_talos --n-starts 20 --workers 1 --no-progress --out /tmp/path_fallback/scenarios
-      keep /tmp/path_fallback/scenarios scenarios ;;
+      keep /tmp/path_fallback/scenarios scenarios
+      .venv/bin/leas hole-sweep --methods navigate --checkpoint checkpoints/leas_talos --n-starts 10 \
+        --workers 1 --no-progress --out /tmp/path_fallback/hole_sweep
+      mkdir -p "$HERE/hole_sweep" && cp /tmp/path_fallback/hole_sweep/hole_sweep.md "$HERE/hole_sweep/" ;;
   esac
 done

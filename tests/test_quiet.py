@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -44,34 +46,26 @@ def test_brax_imports_the_backend_quietly():
     assert done.stdout == "['mujoco.mjx.warp']\n"
 
 
-def test_compiled_code_writes_on_stdout_are_discarded_inside_the_block_only():
-    """What is written on descriptor 1 inside `c_stdout_discarded` (as hpp-centroidal-dynamics'
-    std::cout does) is gone; before and after it, and Python's own print, reach stdout."""
-    code = (
-        "import os\n"
-        "from leas_jax.quiet import c_stdout_discarded\n"
-        "os.write(1, b'before\\n')\n"
+@pytest.mark.parametrize(
+    "before, expected",
+    [
+        # compiled code's writes on descriptor 1 inside the block (as hpp-centroidal-dynamics'
+        # std::cout does) are gone; before and after it, and Python's own print, reach stdout
+        ("os.write(1, b'before\\n')\n", "before\nafter\nprinted\n"),
+        # a print before the block still sits in sys.stdout's buffer (stdout is a pipe here): the
+        # block flushes it before discarding descriptor 1, so it reaches stdout, in order
+        ("print('printed before')\n", "printed before\nafter\nprinted\n"),
+    ],
+    ids=["compiled-writes-discarded", "earlier-print-kept"],
+)
+def test_c_stdout_discarded_drops_what_is_written_inside_the_block_only(before, expected):
+    block = (
         "with c_stdout_discarded():\n"
         "    os.write(1, b'[DEBUG] inside\\n')\n"
         "os.write(1, b'after\\n')\n"
         "print('printed', flush=True)\n"
     )
+    code = "import os\nfrom leas_jax.quiet import c_stdout_discarded\n" + before + block
     done = _python("-c", code)
     assert done.returncode == 0, done.stderr
-    assert done.stdout == "before\nafter\nprinted\n"
-
-
-def test_what_python_printed_before_the_block_is_not_discarded():
-    """A print before the block still sits in sys.stdout's buffer (stdout is a pipe here); the
-    block flushes it before discarding descriptor 1, so it reaches stdout, in order."""
-    code = (
-        "import os\n"
-        "from leas_jax.quiet import c_stdout_discarded\n"
-        "print('printed before')\n"
-        "with c_stdout_discarded():\n"
-        "    os.write(1, b'[DEBUG] inside\\n')\n"
-        "os.write(1, b'after\\n')\n"
-    )
-    done = _python("-c", code)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout == "printed before\nafter\n"
+    assert done.stdout == expected

@@ -694,9 +694,10 @@ def dip_profile(low: np.ndarray, high: np.ndarray, weight: np.ndarray) -> np.nda
     ties) by bounded least squares.
 
     The bounds are narrowed by DIP_INSET x the contact weight on each side where they leave
-    room (their middle where they do not); samples of contact weight [M] (`contact_weight`) under 1e-3, around
-    the key posture, keep the root (0, which must be inside their bounds), and the three
-    samples at the contact end are held level: the root starts and ends the phase at rest.
+    room (their middle where they do not); samples of contact weight [M] (`contact_weight`)
+    under 1e-3, around the key posture, keep the root (0, which must be inside their bounds),
+    and the three samples at the contact end are held level: the root starts and ends the
+    phase at rest.
     """
     from scipy.optimize import lsq_linear
 

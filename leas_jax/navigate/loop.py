@@ -46,7 +46,7 @@ from leas_jax.errors import UsageError
 from leas_jax.navigate import result as reasons
 from leas_jax.navigate.lattice import LatticeConfig, build_lattice, relaxed_reachability
 from leas_jax.navigate.result import Attempt, NavigationResult
-from leas_jax.navigate.search import SearchConfig, SearchResult, graph, search
+from leas_jax.navigate.search import SearchConfig, SearchResult, graph, planar_arc_length, search
 
 
 @dataclass(frozen=True)
@@ -183,9 +183,14 @@ def path_guide(pose: np.ndarray, path: np.ndarray, speed: float, timestep: float
     """
     points = np.concatenate([np.asarray(pose, np.float64)[None, [0, 1, 3]], np.asarray(path, np.float64)[1:]])
     points[:, 2] = np.unwrap(points[:, 2])
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points[:, :2], axis=0).T))])
+    arc = planar_arc_length(points[:, :2])
     at = np.append(np.arange(0.0, arc[-1], speed * timestep), arc[-1])
     return np.stack([np.interp(at, arc, points[:, k]) for k in range(3)], axis=-1)
+
+
+def policy_replans(attempts) -> int:
+    """Searches after the first that the policy walked (what `max_replans` bounds), of `Attempt`s."""
+    return sum(attempt.kind == "policy" for attempt in attempts) - 1
 
 
 def _fmt(xy) -> str:
@@ -498,7 +503,7 @@ class Navigator:
             return self._finish(state, state.search.reason, self._unreachable_text(state), k)
         # the generator stopped on the policy's guide: its searched path is walked next, unpenalised
         fallback = cfg.path_fallback and failure is not None and not policy_stalled and state.kind == "policy"
-        if sum(a.kind == "policy" for a in state.attempts) > cfg.max_replans and not fallback:
+        if policy_replans(state.attempts) >= cfg.max_replans and not fallback:
             if state.unreachable is not None:
                 return self._finish(state, state.unreachable, self._unreachable_text(state), k)
             where = guide[-1, :2] if failure is None else failure
@@ -513,13 +518,8 @@ class Navigator:
             begin = total - 1
         else:  # penalise the failed region (unless the path is tried first), search again before it
             if not fallback:
-                cells = self.lattice.position(
-                    np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
-                )
-                state.penalty += cfg.failure_penalty * (
-                    np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
-                )
-            walked = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(guide[: last + 1, :2], axis=0).T))])
+                self._penalise(state, failure)
+            walked = planar_arc_length(guide[: last + 1, :2])
             begin = int(np.searchsorted(walked, walked[-1] - cfg.backoff_distance, side="right")) - 1
             begin = max(0, begin)
         pose = guide[begin]
@@ -559,6 +559,16 @@ class Navigator:
         state.guide = np.concatenate([guide[:begin], segment])
         state.segment_begin = begin
         return state.guide
+
+    def _penalise(self, state: _State, failure: np.ndarray) -> None:
+        """Add `failure_penalty` to the cells within `failure_radius` of failure [2] (world)."""
+        cfg = self.config
+        cells = self.lattice.position(
+            np.stack(np.meshgrid(*map(np.arange, self.lattice.shape[:2]), indexing="ij"), -1)
+        )
+        state.penalty += cfg.failure_penalty * (
+            np.hypot(*(cells - failure).transpose(2, 0, 1)) <= cfg.failure_radius
+        )
 
     def _path_segment(self, pose: np.ndarray, path: np.ndarray) -> np.ndarray:
         """Guide segment [T, 4] from a verified guide pose [4] (kept as it is, first) along a
@@ -630,7 +640,7 @@ class Navigator:
             guide=guide,
             waypoints=state.waypoints,
             path=state.path,
-            replans=sum(a.kind == "policy" for a in state.attempts) - 1,
+            replans=policy_replans(state.attempts),
             attempts=tuple(state.attempts),
             final_distance=float(distance),
             seconds=dict(state.seconds),

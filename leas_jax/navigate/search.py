@@ -214,13 +214,18 @@ def _frontier(adjacency, heads: np.ndarray, settled: np.ndarray) -> np.ndarray:
     return settled[heads] & ~settled[adjacency.indices]
 
 
+def planar_arc_length(xy: np.ndarray) -> np.ndarray:
+    """[N] length (m) of the horizontal polyline through points xy [N, 2] (world) from point 0 to each."""
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])
+
+
 def _waypoints(path_xy: np.ndarray, spacing: float) -> np.ndarray:
     """Points of the path every `spacing` m of arc length (lattice nodes), its end last. -> [W, 2]."""
     keep = np.concatenate([[True], np.any(np.diff(path_xy, axis=0) != 0, axis=1)])
     xy = path_xy[keep]
     if len(xy) == 1:
         return xy.copy()
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])
+    s = planar_arc_length(xy)
     marks = np.arange(spacing, s[-1], spacing)
     picks = np.searchsorted(s, marks)
     picks = np.unique(np.concatenate([picks, [len(xy) - 1]]))

@@ -93,6 +93,12 @@ DIP_INSET = 0.005
 # (`_single_support`; one is enough where its references scale with its duration, the next
 # ones take up the samples' rounding).
 STRETCHES = 4
+# ... and for its joints' speed: the configurations its CoM references come from (the root held
+# or profiled, `held_root_support`) keep each joint within this fraction of its velocity limit
+# (times `MotionConfig.velocity_ratio`). The whole-body IK tracks their CoM, not their root,
+# and ends close to them; a crouched swing leg unbends fast in the landing's descent (circuit_0:
+# the right knee from 1.76 to 0.30 rad in 0.32 s, -7.2 rad/s where its limit is 7).
+SPEED_MARGIN = 0.9
 
 
 class MotionError(LeasError):
@@ -488,7 +494,16 @@ def single_support_schedule(talos, q: np.ndarray, feet: np.ndarray, swing: int, 
 def single_support_coms(
     talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
 ) -> np.ndarray:
-    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1.
+    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1
+    (`held_root_support`'s)."""
+    return held_root_support(talos, q, feet, rotations, swing, lifting, config)[0]
+
+
+def held_root_support(
+    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+) -> tuple[np.ndarray, np.ndarray]:
+    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1, and the
+    configurations [M, 39] they are taken from.
 
     q [39]: the phase's one-foot key posture; feet [M, 2, 4, 4]: the soles' references;
     rotations [M, 3, 3]: the root's orientation references.
@@ -522,9 +537,9 @@ def single_support_coms(
     weight, knees, toward = single_support_schedule(talos, q, feet, swing, lifting, config)
     data = talos.model.createData()
 
-    def attempt(margin: float) -> np.ndarray:
-        """CoMs [M, 3] of the held-root configurations with leg joints `margin` rad inside their
-        limits (MotionError: none)."""
+    def attempt(margin: float) -> tuple[np.ndarray, np.ndarray]:
+        """CoMs [M, 3] of the held-root configurations [M, 39] with leg joints `margin` rad inside
+        their limits, and those configurations (MotionError: none)."""
         shifts = np.zeros((len(feet), 2))
         needs = np.array(
             [root_dip(talos, q, *sample, margin=margin) for sample in zip(feet, rotations, shifts, knees)]
@@ -558,15 +573,17 @@ def single_support_coms(
             )
             raise MotionError(f"the root would have to {move} for the soles to reach")
         coms = np.empty((len(feet), 3))
+        configurations = np.empty((len(feet), len(q)))
         for i, (f, shift) in enumerate(zip(feet, shifts)):
             offset = np.r_[shift, -depth * weight[i]]
             configuration = held_root_configuration(talos, q, f, rotations[i], offset, knees[i], margin)
             if configuration is None:
                 raise MotionError(f"at sample {i} the soles are out of the legs' reach with the root lowered")
             coms[i] = pin.centerOfMass(talos.model, data, configuration, False)
+            configurations[i] = configuration
         if sign > 0:
             coms[:, :2] = lerp(coms[0, :2], coms[-1, :2], min_jerk(np.arange(len(feet)) / (len(feet) - 1)))
-        return coms
+        return coms, configurations
 
     try:  # leg joints kept LIMIT_MARGIN inside their limits where that works
         return attempt(LIMIT_MARGIN)
@@ -577,7 +594,16 @@ def single_support_coms(
 def profiled_single_support_coms(
     talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
 ) -> np.ndarray:
-    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1 whose root
+    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1
+    (`profiled_support`'s)."""
+    return profiled_support(talos, q, feet, rotations, swing, lifting, config)[0]
+
+
+def profiled_support(
+    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+) -> tuple[np.ndarray, np.ndarray]:
+    """CoM references [M, 3] (world, m), and the configurations [M, 39] they are taken from, of
+    a single-support phase's samples 0..M-1 whose root
     height is chosen sample by sample: where no single depth on the contact weight reaches
     every sample (`single_support_coms` fails: the swing leg needs the root high at one sample
     and low at another, or a rise over MAX_RISE close to the key posture).
@@ -618,7 +644,9 @@ def profiled_single_support_coms(
         if any(c is None for c in configurations):  # a gap inside a bisected interval
             unreached = next(i for i, c in enumerate(configurations) if c is None)
             continue
-        return np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations])
+        return np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations]), np.array(
+            configurations
+        )
     raise MotionError(
         f"at sample {unreached} the soles are out of the legs' reach at every root height from "
         f"{MAX_PROFILE_RISE:g} m higher to {MAX_DIP:g} m lower"
@@ -883,17 +911,20 @@ def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tu
     from leas_jax.motion.paths import shift_duration
 
     limit, dt = config.single_support_acceleration, config.dt
-    coms, profiled = _single_support_coms(talos, spec, k, config)
+    speeds = talos.model.velocityLimit[6:] * config.velocity_ratio * SPEED_MARGIN
+    coms, configurations, profiled = _single_support_coms(talos, spec, k, config)
     for _ in range(STRETCHES):
         distance = float(np.linalg.norm(coms[-1] - coms[0]))
         seconds = shift_duration(distance, limit, spec.samples * dt, dt)
         samples = max(
-            round(seconds / dt), stretched_samples(coms, spec.samples, limit, dt, vertical=profiled)
+            round(seconds / dt),
+            stretched_samples(coms, spec.samples, limit, dt, vertical=profiled),
+            speed_samples(configurations, spec.samples, speeds, dt),
         )
         if samples <= spec.samples:
             break
         spec = dataclasses.replace(spec, samples=samples)
-        coms, profiled = _single_support_coms(talos, spec, k, config)
+        coms, configurations, profiled = _single_support_coms(talos, spec, k, config)
     return spec, coms
 
 
@@ -920,10 +951,22 @@ def stretched_samples(
     return max(samples, math.ceil(samples * math.sqrt(peak / limit) - 1e-9))
 
 
-def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[np.ndarray, bool]:
-    """`single_support_coms` [n + 1, 3] of a lift or land spec's samples 0..n, else
-    `profiled_single_support_coms`, and whether the latter made them (MotionError naming
-    postures k and k + 1 and both reasons)."""
+def speed_samples(configurations: np.ndarray, samples: int, speeds: np.ndarray, dt: float) -> int:
+    """Samples (at least `samples`) of a phase whose configurations [samples + 1, 39] (functions
+    of normalised time, sampled every dt s) keep every joint's speed within speeds [32], rad/s,
+    when played over them: speeds scale with the inverse of the duration."""
+    peak = float((np.abs(np.diff(configurations[:, 7:], axis=0)) / dt / speeds).max())
+    if peak <= 1.0:
+        return samples
+    return max(samples, math.ceil(samples * peak - 1e-9))
+
+
+def _single_support_coms(
+    talos, spec: _PhaseSpec, k: int, config: MotionConfig
+) -> tuple[np.ndarray, np.ndarray, bool]:
+    """`held_root_support`'s CoMs [n + 1, 3] and configurations [n + 1, 39] of a lift or land
+    spec's samples 0..n, else `profiled_support`'s, and whether the latter made them
+    (MotionError naming postures k and k + 1 and both reasons)."""
     from leas_jax.motion.paths import slerp
 
     fractions = np.arange(spec.samples + 1) / spec.samples
@@ -931,11 +974,11 @@ def _single_support_coms(talos, spec: _PhaseSpec, k: int, config: MotionConfig) 
     rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config)
     try:
-        return single_support_coms(*arguments), False
+        return *held_root_support(*arguments), False
     except MotionError as exc:
         held = exc
     try:
-        return profiled_single_support_coms(*arguments), True
+        return *profiled_support(*arguments), True
     except MotionError as exc:
         raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {held}; sample by sample: {exc}") from None
 

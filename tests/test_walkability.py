@@ -1,12 +1,14 @@
 """The walkability model: terrain families, the plausible set and the model's verdicts (shapes,
 jit), a known rule learned from synthetic labels, the label cache's invalidation, rates, and the
-`leas feasibility walkability` command's errors."""
+`leas feasibility walkability` command's errors, and the warning where a model was labelled by
+another generator."""
 
 from __future__ import annotations
 
 import dataclasses
 import subprocess
 import sys
+import warnings
 
 import jax
 import numpy as np
@@ -127,6 +129,28 @@ def test_walking_labels_are_cached_and_rebuilt_when_the_generator_changes(tmp_pa
     assert not wk.walking_labels(terrain, poses, tmp_path, workers=0, generator_config=other).any()
     moved = loads_terrain(family_terrain("gaps", 1))  # another terrain text: another key
     assert not wk.walking_labels(moved, poses, tmp_path, workers=0).any()
+
+
+def test_a_model_labelled_by_another_generator_warns_when_loaded(tmp_path):
+    """The build records the generator's key; loading a model whose key is not the current
+    generator's warns, naming the file; one with the current key, or with none (built before the
+    key was recorded), loads silently."""
+    from leas_jax.contacts.planner.config import GeneratorConfig
+    from leas_jax.env import learned_feasibility as lf
+    from leas_jax.feasibility.walking_truth import StaleConditionWarning, generator_key
+
+    reach = ReachabilityConfig()
+    params = lf.init_params(jax.random.PRNGKey(0), hidden=(8, 4), reach=reach)
+    assert generator_key() != generator_key(dataclasses.replace(GeneratorConfig(), lookahead=0.6))
+    stale = lf.save_params(tmp_path / "stale.npz", params, generator_key="0" * 64)
+    with pytest.warns(StaleConditionWarning, match="stale.npz: the walkability model was fitted"):
+        wk.load_walkability(stale, reach)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        wk.load_walkability(
+            lf.save_params(tmp_path / "now.npz", params, generator_key=generator_key()), reach
+        )
+        wk.load_walkability(lf.save_params(tmp_path / "unkeyed.npz", params), reach)
 
 
 @pytest.mark.parametrize(

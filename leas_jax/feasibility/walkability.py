@@ -36,7 +36,13 @@ from leas_jax.env import reachability
 from leas_jax.env.field import sample_nearest
 from leas_jax.env.reachability import relaxed_reachability
 from leas_jax.feasibility.label_cache import cached_labels
-from leas_jax.feasibility.walking_truth import WALK_TIMESTEP, dataset_key, walking_guide
+from leas_jax.feasibility.walking_truth import (
+    WALK_TIMESTEP,
+    dataset_key,
+    generator_key,
+    walking_guide,
+    warn_if_stale,
+)
 from leas_jax.terrain.families import FAMILIES, FEATURE_X, family_terrain
 
 WEIGHTS = "checkpoints/walkability/walkability.npz"  # the shipped model (relative to the repository)
@@ -146,6 +152,9 @@ def load_walkability(path, reach):
     """The walkability model's `LearnedParams` from an .npz of `leas feasibility walkability` (a path as given
     or relative to the repository).
 
+    Warns (`walking_truth.StaleConditionWarning`) where the model records the key of another
+    contact generator than the current one (`walking_truth.stale_weights`).
+
     Raises:
         UsageError: the file cannot be read, or its model reads the margins of another
             `ReachabilityConfig` than `reach` (the field's rasters).
@@ -161,6 +170,7 @@ def load_walkability(path, reach):
         params, metadata = load_params(resolved)
     except ValueError as error:
         raise UsageError(str(error)) from None
+    warn_if_stale(resolved, metadata)
     fitted = metadata.get("reachability")
     if fitted is not None and json.loads(fitted) != dataclasses.asdict(reach):
         raise UsageError(
@@ -458,6 +468,7 @@ def build(
         out,
         params,
         data_key=key,
+        generator_key=generator_key(),
         model="walkability",
         families=json.dumps(
             {"train": list(config.train_families), "held_out": list(config.held_out_families)}

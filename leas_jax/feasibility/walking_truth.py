@@ -4,8 +4,10 @@ key of everything such a label depends on. Host-only.
 A pose is feasible when the contact generator covers the short straight guide that starts at
 it along its yaw (`walking_guide`, planned at WALK_TIMESTEP). The learned condition's weights
 (`leas feasibility condition`, `condition_build`) record the `dataset_key` of the labels they were fitted
-on; `stale_weights` compares it with the key the current generator gives, so that a run about to
-train with weights fitted on another generator's verdicts says so.
+on, the walkability model's (`leas feasibility walkability`) the `generator_key` of the generator
+that labelled its families; `stale_weights` compares either with the key the current generator
+gives, so that a run about to train or a search about to read weights fitted on another
+generator's verdicts says so.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ WALK_POSES = 21  # guide poses 0.018 m apart (0.36 m in 2 s: two or three footst
 WALK_SPEED = 0.18  # m/s, the target speed (paper §IV)
 WALK_TIMESTEP = 0.1  # s, paper Table I
 RELABEL_COMMAND = "leas feasibility condition --workers 2"
+REBUILD_WALKABILITY_COMMAND = "leas feasibility walkability --workers 2"
 _REPO = Path(__file__).resolve().parents[2]
 
 
@@ -58,6 +61,18 @@ def dataset_key(terrain_text: str, generator_config, sources_root: Path | None =
     return digest.hexdigest()
 
 
+def generator_key(generator_config=None) -> str:
+    """sha256 (hex) of the contact generator alone: its settings (None: `GeneratorConfig()`) and
+    its code (`spawns.GENERATOR_SOURCES`). What every walking label depends on besides its terrain."""
+    if generator_config is None:
+        from leas_jax.contacts.planner.config import GeneratorConfig
+
+        generator_config = GeneratorConfig()
+    digest = hashlib.sha256(repr(generator_config).encode())
+    digest.update(generator_code_digest(GENERATOR_SOURCES).encode())
+    return digest.hexdigest()
+
+
 def stale_weights(path: Path, metadata: dict, generator_config=None) -> str | None:
     """Why the weights in `path` no longer match the generator, or None where they do or cannot tell.
 
@@ -65,11 +80,23 @@ def stale_weights(path: Path, metadata: dict, generator_config=None) -> str | No
         path: the weights file (for the message).
         metadata: its metadata (`learned_weights.load_params`): `data_key` and `terrain`, the
             labels' key and terrain file (relative to the repository root), as
-            `leas feasibility condition` writes them. Weights without them (the
-            planner phase's refits, hand-made weights) cannot be checked: None.
+            `leas feasibility condition` writes them; or `generator_key`, as
+            `leas feasibility walkability` writes it. Weights without them (the planner
+            phase's refits, hand-made weights, walkability models built before the key was
+            recorded) cannot be checked: None.
         generator_config: the generator to compare with (None: `GeneratorConfig()`, the one
             the labels are made with).
     """
+    recorded = metadata.get("generator_key")
+    if recorded:
+        now = generator_key(generator_config)
+        if now == recorded:
+            return None
+        return (
+            f"{path}: the walkability model was fitted on walking verdicts of another contact generator "
+            f"(labels {recorded[:12]}, the current generator's {now[:12]}): it may disagree with the "
+            f"generator; rebuild it with `{REBUILD_WALKABILITY_COMMAND}`"
+        )
     key, terrain = metadata.get("data_key"), metadata.get("terrain")
     if not key or not terrain:
         return None

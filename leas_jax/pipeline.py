@@ -15,7 +15,7 @@ from leas_jax.training.commands import add_training_arguments, config_from_args
 def cmd_run(args) -> int:
     """Geometric training, planner-in-the-loop fine-tuning, evaluation report (each phase resumes)."""
     from leas_jax.eval.report import write_report
-    from leas_jax.training.config import preset
+    from leas_jax.training.config import PLANNER_PRESETS, preset
     from leas_jax.training.loop import train
 
     out = Path(args.out)
@@ -23,9 +23,10 @@ def cmd_run(args) -> int:
         raise UsageError("leas run trains both phases itself: drop --mode and --init")
     geometric = config_from_args(args)
     train(geometric, out / "geometric", progress=not args.no_progress, allow_pickle=args.allow_pickle)
-    if args.planner_steps > 0:
+    planner_steps = PLANNER_PRESETS[args.preset]["num_timesteps"] if args.planner_steps is None else args.planner_steps
+    if planner_steps > 0:
         overrides = {
-            "num_timesteps": args.planner_steps,
+            "num_timesteps": planner_steps,
             "init_from": str(out / "geometric"),
             "terrain": geometric.terrain,
             "seed": geometric.seed,
@@ -70,8 +71,9 @@ def register(subparsers) -> None:
     run.add_argument(
         "--planner-steps",
         type=int,
-        default=150_000,
-        help="kept env steps of planner-in-the-loop fine-tuning (default 150 000; 0 skips it; see docs/results for 500 000)",
+        default=None,
+        help="kept env steps of planner-in-the-loop fine-tuning (default: the preset's planner budget, "
+        "`quick` 150 000; 0 skips it)",
     )
     run.add_argument(
         "--compare-starts",

@@ -23,7 +23,9 @@ def cmd_run(args) -> int:
         raise UsageError("leas run trains both phases itself: drop --mode and --init")
     geometric = config_from_args(args)
     train(geometric, out / "geometric", progress=not args.no_progress, allow_pickle=args.allow_pickle)
-    planner_steps = PLANNER_PRESETS[args.preset]["num_timesteps"] if args.planner_steps is None else args.planner_steps
+    planner_steps = (
+        PLANNER_PRESETS[args.preset]["num_timesteps"] if args.planner_steps is None else args.planner_steps
+    )
     if planner_steps > 0:
         overrides = {
             "num_timesteps": planner_steps,

@@ -75,7 +75,7 @@ def register(subparsers) -> None:
         type=int,
         default=None,
         help="kept env steps of planner-in-the-loop fine-tuning (default: the preset's planner budget, "
-        "`quick` 150 000; 0 skips it)",
+        "`quick` 100 000; 0 skips it)",
     )
     run.add_argument(
         "--compare-starts",

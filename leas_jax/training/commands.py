@@ -26,7 +26,7 @@ def add_training_arguments(parser) -> None:
         help="geometric: smoke (< 1 min), quick (30 M steps, 3 epochs, clearance reward term, "
         "~3 min on 2 cores with the cylinders, ~6 with the learned condition), paper (80 M steps, 10 epochs, the paper's reward, ~25 min); "
         "planner: smoke (20 k kept steps from scratch), quick and paper (the geometric preset of the same name in "
-        "<out>/pretrain, then 150 k / 600 k kept steps with the planner)",
+        "<out>/pretrain, then 100 k / 600 k kept steps with the planner)",
     )
     parser.add_argument(
         "--mode",

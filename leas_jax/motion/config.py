@@ -114,6 +114,13 @@ class SimulationConfig:
     # phase, the whole robot with its soles), and without it the landing error passes 3 cm
     # after 130-240 s of motion on flat ground and on eval_stairs. False: joint references alone.
     landing_correction: bool = True
+    # Iterations of MuJoCo's noslip solver (`mjOption.noslip_iterations`) after its main
+    # solver: its soft frictional contacts hold a sustained tangential load by a creep
+    # velocity, not by static friction, so soles on a slope slide downhill though the load is
+    # well inside the friction cone (eval_circuit's 10 deg ramp, mu = 0.5: 1-2.5 cm per double
+    # support, falling after 12 steps up it). 5 suppress that creep (circuit_0: 1.4 mm at most
+    # over 1 226 s, simulation 1.4 x slower). 0: MuJoCo's default, the soles creep.
+    noslip_iterations: int = 0
     # Seconds simulated after the motion's last sample (the robot must stay up).
     settle: float = 0.5
     # Success: the root (base_link) stays above `min_root_height` over the higher sole in

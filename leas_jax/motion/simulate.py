@@ -210,6 +210,7 @@ def simulate(
     if terrain is None:
         terrain = loads_terrain(motion.terrain, source="<motion terrain>")
     mj = terrain_scene(terrain, config.timestep)
+    mj.model.opt.noslip_iterations = config.noslip_iterations
     talos = load_talos()
     model = mj.model
     data = mujoco.MjData(model)

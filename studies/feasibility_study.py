@@ -12,7 +12,7 @@ Four methods, each trained from scratch with every seed of `--seeds`:
 
 A planner phase continues its method's own geometric run, so each seed's pair differs only by
 the planner phase (a paired comparison); it adds `--planner-steps` env steps to the geometric
-budget (150 k against 80 M for `quick`: 0.2 %), so the methods train at equal env steps to
+budget (100 k against 30 M for `quick`: 0.3 %), so the methods train at equal env steps to
 within that.
 
 Per policy (deterministic): on the training arena, from the env's own random resets

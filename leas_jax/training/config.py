@@ -322,8 +322,9 @@ PLANNER_PRESETS = {
         num_timesteps=100_000, num_envs=64, num_minibatches=4, num_epochs=4, pretrain="quick", env=QUICK_ENV
     ),
     "paper": dict(num_timesteps=600_000, num_envs=64, num_minibatches=4, num_epochs=10, pretrain="paper"),
-    # `quick`'s fine-tuning settings (its earlier 150 k kept steps) of the generalist pretrain; its episodes start on rows 0 to
-    # CurriculumConfig.initial_max_level of the curriculum (the rows move with geometric episodes)
+    # `quick`'s fine-tuning settings (and its earlier 150 k kept steps) on the generalist
+    # pretrain; its episodes start on rows 0 to CurriculumConfig.initial_max_level of the
+    # curriculum (the rows move with geometric episodes)
     "generalist": dict(
         num_timesteps=150_000,
         num_envs=64,

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from leas_jax.arguments import positive_int
+from leas_jax.arguments import non_negative_int, positive_int
 from leas_jax.errors import UsageError
 from leas_jax.training.commands import add_training_arguments, config_from_args
 
@@ -72,7 +72,7 @@ def register(subparsers) -> None:
     )
     run.add_argument(
         "--planner-steps",
-        type=int,
+        type=non_negative_int,
         default=None,
         help="kept env steps of planner-in-the-loop fine-tuning (default: the preset's planner budget, "
         "`quick` 100 000; 0 skips it)",

@@ -1,5 +1,8 @@
 """`leas run`: its phases' configurations, with training and the report stood in for."""
 
+import subprocess
+import sys
+
 import pytest
 
 from leas_jax.cli import build_parser
@@ -36,3 +39,14 @@ def test_run_planner_steps_override_the_budget_and_zero_skips_the_phase(monkeypa
     assert trained[1].num_timesteps == 1234
     trained, reports = _phases(monkeypatch, tmp_path, "--planner-steps", "0")
     assert [c.mode for c in trained] == ["geometric"] and len(reports) == 1
+
+
+def test_run_refuses_negative_planner_steps_in_one_line():
+    result = subprocess.run(
+        [sys.executable, "-m", "leas_jax.cli", "run", "--out", "x", "--planner-steps", "-5"],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 2
+    assert "--planner-steps: expected an integer >= 0, got '-5'" in result.stderr
+    assert "Traceback" not in result.stderr

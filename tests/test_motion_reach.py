@@ -15,11 +15,11 @@ from leas_jax.motion.motion import (
     contact_weight,
     dip_profile,
     held_root_configuration,
+    held_root_support,
     posture_frames,
-    profiled_single_support_coms,
+    profiled_support,
     reach_interval,
     root_dip,
-    single_support_coms,
     stretched_samples,
 )
 
@@ -78,12 +78,12 @@ def test_a_swing_needing_the_root_low_midway_and_high_at_contact_is_made():
     path[:, 0, 2, 3] += 0.2 * t - 0.3 * np.sin(np.pi * t)
     rotations = np.repeat(rotation[None], 81, axis=0)
     with pytest.raises(MotionError):
-        single_support_coms(talos, q, path, rotations, 0, False, config)
+        held_root_support(talos, q, path, rotations, 0, False, config)
     with pytest.raises(MotionError, match="profiled_reach"):
-        profiled_single_support_coms(
+        profiled_support(
             talos, q, path, rotations, 0, False, dataclasses.replace(config, profiled_reach=False)
         )
-    coms = profiled_single_support_coms(talos, q, path, rotations, 0, False, config)
+    coms = profiled_support(talos, q, path, rotations, 0, False, config)[0]
     np.testing.assert_allclose(coms[0], com, atol=1e-6)  # the key posture's root, held
     assert coms[40, 2] < com[2] - 0.03  # come down midway
     assert np.abs(np.diff(coms[:, 2], 2)).max() < 1e-3

@@ -45,7 +45,7 @@ class MotionConfig:
     min_knee: float = 0.3
     # Where no single depth (or rise) on the contact weight lets the legs reach every sample
     # of a single support, the root's height is chosen sample by sample inside what reaches,
-    # the least-jerk profile at rest at both ends (`motion.profiled_single_support_coms`).
+    # the least-jerk profile at rest at both ends (`motion.profiled_support`).
     # navigate's plans on rough scenes need it: rubbles_stairs_2_0's landing 49 -> 50 needs
     # the root 3-9 cm higher late in the swing but at most 1 cm higher at the contact, and
     # rubble_0's landing 75 -> 76 a 0.14 m rise in mid-swing (MAX_RISE: 0.15 m on the weight).

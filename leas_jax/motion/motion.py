@@ -66,7 +66,7 @@ MOTION_KEYS = (
 )
 PHASE_KINDS = ("shift", "lift", "land")
 # Single support: the root comes down at most this far, m, for the swing sole to reach its
-# contact (`single_support_coms`), found by steps of DIP_SCAN, m.
+# contact (`held_root_support`), found by steps of DIP_SCAN, m.
 MAX_DIP = 0.30
 DIP_SCAN = 0.01
 # ... or rises at most this far, m, where no lowering lets a leg reach its sole: crouched
@@ -480,7 +480,7 @@ def single_support_schedule(talos, q: np.ndarray, feet: np.ndarray, swing: int, 
     weight falls), the unit horizontal direction [2] along the stance sole towards the swing
     sole at contact, world).
 
-    Arguments as `single_support_coms`.
+    Arguments as `held_root_support`.
     """
     weight = contact_weight(len(feet), lifting)
     bent = np.array([q[leg.q_index[3]] for leg in talos.legs])
@@ -489,14 +489,6 @@ def single_support_schedule(talos, q: np.ndarray, feet: np.ndarray, swing: int, 
     ahead = contact[1 - swing][:2, 0] / max(float(np.linalg.norm(contact[1 - swing][:2, 0])), 1e-9)
     toward = np.sign(ahead @ (contact[swing][:2, 3] - contact[1 - swing][:2, 3])) * ahead
     return weight, knees, toward
-
-
-def single_support_coms(
-    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
-) -> np.ndarray:
-    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1
-    (`held_root_support`'s)."""
-    return held_root_support(talos, q, feet, rotations, swing, lifting, config)[0]
 
 
 def held_root_support(
@@ -591,24 +583,16 @@ def held_root_support(
         return attempt(0.0)
 
 
-def profiled_single_support_coms(
-    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
-) -> np.ndarray:
-    """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1
-    (`profiled_support`'s)."""
-    return profiled_support(talos, q, feet, rotations, swing, lifting, config)[0]
-
-
 def profiled_support(
     talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
 ) -> tuple[np.ndarray, np.ndarray]:
     """CoM references [M, 3] (world, m), and the configurations [M, 39] they are taken from, of
     a single-support phase's samples 0..M-1 whose root
     height is chosen sample by sample: where no single depth on the contact weight reaches
-    every sample (`single_support_coms` fails: the swing leg needs the root high at one sample
+    every sample (`held_root_support` fails: the swing leg needs the root high at one sample
     and low at another, or a rise over MAX_RISE close to the key posture).
 
-    Arguments as `single_support_coms`. The root keeps the key posture's horizontal position
+    Arguments as `held_root_support`. The root keeps the key posture's horizontal position
     (else moved `config.lean` along the stance sole, as there); its lowering at each sample
     lies inside what reaches (`reach_interval`, leg joints LIMIT_MARGIN inside their limits,
     else 0), the smoothest such profile at rest at both ends (`dip_profile`). The CoM is that
@@ -818,7 +802,7 @@ def centred_postures(talos, plan: ContactPlan, frames, margin: float, ik) -> tup
 def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) -> list[_PhaseSpec]:
     """Phases from plan posture k to k + 1.
 
-    In single support the CoM follows `single_support_coms` (the root held at the one-foot
+    In single support the CoM follows `held_root_support` (the root held at the one-foot
     posture's placement, lowered where the swing sole needs it); the double-support shift
     around it goes to or from that phase's CoM with the swing sole on the ground.
 
@@ -895,8 +879,8 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) 
 
 
 def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[_PhaseSpec, np.ndarray]:
-    """A lift or land spec, lengthened where its CoM moves far or fast, and its
-    `single_support_coms` [n + 1, 3] of samples 0..n.
+    """A lift or land spec, lengthened where its CoM moves far or fast or its joints turn fast,
+    and its CoM references [n + 1, 3] of samples 0..n (`_single_support_coms`).
 
     The phase lasts long enough for the CoM to stay under `config.single_support_acceleration`:
     its peak acceleration along a minimum-jerk move of its end-to-end distance

@@ -60,7 +60,7 @@ def navigate_config(args):
 
 def _path_walks(result) -> str:
     """ ", N along the searched path" for the attempts whose searched path was walked itself, or ""."""
-    walks = len(result.attempts) - 1 - result.replans
+    walks = sum(attempt.kind == "path" for attempt in result.attempts)
     return f", {walks} along the searched path" if walks else ""
 
 

@@ -51,6 +51,16 @@ class MotionConfig:
     # rubble_0's landing 75 -> 76 a 0.14 m rise in mid-swing (MAX_RISE: 0.15 m on the weight).
     # Only phases the held-root depth cannot make use it. False: those phases fail as before.
     profiled_reach: bool = True
+    # Where no height profile reaches either (a wide or long step on rough ground: the swing
+    # sole lands or lifts beyond the legs' reach, or past the hip and ankle roll limits, from
+    # the root over the stance sole), the root moves horizontally too, by up to `root_shift`,
+    # m, on the contact weight, while the CoM stays `single_support_margin`, m, inside the
+    # stance sole at every sample (`motion.shifted_support`; the sole is 0.13 m wide, the key
+    # postures' CoMs some 6 cm inside it). Measured on navigate's plans of hpp_darpa,
+    # hpp_rubble, hpp_stairs and rubble-and-stairs scenes: a 0.10 m shift leaves 2.8-6.5 cm of
+    # margin at every sample of the phases that failed. 0: those phases fail as before.
+    root_shift: float = 0.10
+    single_support_margin: float = 0.03
     # Double-support key postures whose CoM lies closer than this to the edge of their soles'
     # support polygon (convex hull of both soles' corners, horizontal projection), m, are
     # reached with their CoM moved towards the polygon's centre until it is this far inside

@@ -89,6 +89,9 @@ LIMIT_MARGIN = 0.03
 # 5 mm step at the first sample off it, 50 m/s^2 at any duration, so that lengthening the phase
 # for its acceleration never ended (rubble_1's lift 140 -> 141: 554 -> 5 080 samples).
 DIP_INSET = 0.005
+# A phase's root height profile is solved at most at this many samples and interpolated
+# between them (`dip_profile`): 1.6 s of a phase at 100 Hz, twice the landing's nominal 0.8 s.
+PROFILE_KNOTS = 161
 # A single-support phase is lengthened at most this many times for its CoM's acceleration
 # (`_single_support`; one is enough where its references scale with its duration, the next
 # ones take up the samples' rounding).
@@ -99,6 +102,9 @@ STRETCHES = 4
 # and ends close to them; a crouched swing leg unbends fast in the landing's descent (circuit_0:
 # the right knee from 1.76 to 0.30 rad in 0.32 s, -7.2 rad/s where its limit is 7).
 SPEED_MARGIN = 0.9
+# Root shifts tried in single support where no height profile reaches (`shifted_support`):
+# multiples of this, m, up to `MotionConfig.root_shift`.
+ROOT_SHIFT_STEP = 0.02
 
 
 class MotionError(LeasError):
@@ -611,29 +617,107 @@ def profiled_support(
     lean = config.lean * weight[:, None] * toward
     unreached = 0
     for shifts, margin in itertools.product((np.zeros((len(feet), 2)), lean), (LIMIT_MARGIN, 0.0)):
-        low, high, out_of_reach = reach_intervals(talos, q, feet, rotations, shifts, knees, margin)
-        if out_of_reach is not None:
-            unreached = out_of_reach
-            continue
-        key = weight < 1e-3
-        if (low[key] > 0.0).any() or (high[key] < 0.0).any():
-            unreached = int(np.flatnonzero(key & ((low > 0.0) | (high < 0.0)))[0])
-            continue
-        dips = dip_profile(low, high, weight)
-        offsets = np.c_[shifts, -dips]
-        configurations = [
-            held_root_configuration(talos, q, *sample, margin)
-            for sample in zip(feet, rotations, offsets, knees)
-        ]
-        if any(c is None for c in configurations):  # a gap inside a bisected interval
-            unreached = next(i for i, c in enumerate(configurations) if c is None)
-            continue
-        return np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations]), np.array(
-            configurations
+        configurations, unreached = profiled_configurations(
+            talos, q, feet, rotations, shifts, knees, weight, margin
         )
+        if configurations is not None:
+            return np.array(
+                [pin.centerOfMass(talos.model, data, c, False) for c in configurations]
+            ), configurations
     raise MotionError(
         f"at sample {unreached} the soles are out of the legs' reach at every root height from "
         f"{MAX_PROFILE_RISE:g} m higher to {MAX_DIP:g} m lower"
+    )
+
+
+def profiled_configurations(
+    talos, q: np.ndarray, feet, rotations, shifts, knees, weight: np.ndarray, margin: float
+) -> tuple[np.ndarray | None, int]:
+    """Configurations [M, 39] of a single-support phase's samples with q's root moved
+    horizontally by shifts [M, 2] (world, m) and lowered along the least-jerk profile inside
+    what reaches (`reach_intervals`, `dip_profile`), or None; and the first sample found out
+    of reach (0 when none is).
+
+    feet [M, 2, 4, 4], rotations [M, 3, 3], knees [M, 2], margin: as `held_root_configuration`;
+    weight [M]: `contact_weight` (its samples under 1e-3, around the key posture, keep the root
+    at the key posture's height, which must reach).
+    """
+    low, high, out_of_reach = reach_intervals(talos, q, feet, rotations, shifts, knees, margin)
+    if out_of_reach is not None:
+        return None, out_of_reach
+    key = weight < 1e-3
+    if (low[key] > 0.0).any() or (high[key] < 0.0).any():
+        return None, int(np.flatnonzero(key & ((low > 0.0) | (high < 0.0)))[0])
+    offsets = np.c_[shifts, -dip_profile(low, high, weight)]
+    configurations = [
+        held_root_configuration(talos, q, *sample, margin) for sample in zip(feet, rotations, offsets, knees)
+    ]
+    if any(c is None for c in configurations):  # a gap inside a bisected interval
+        return None, next(i for i, c in enumerate(configurations) if c is None)
+    return np.array(configurations), 0
+
+
+def shift_candidates(longest: float, step: float, toward: np.ndarray) -> np.ndarray:
+    """Horizontal root shifts [C, 2] (world, m) of `shifted_support`, shortest first: every
+    multiple of `step` up to `longest` in 8 directions 45 deg apart, those of one length in
+    decreasing alignment with toward [2] (a unit vector, world)."""
+    lengths = np.arange(1, math.floor(longest / step + 1e-9) + 1) * step
+    angles = np.arange(8) * (np.pi / 4)
+    directions = np.c_[np.cos(angles), np.sin(angles)]
+    directions = directions[np.argsort(-(directions @ toward), kind="stable")]
+    return (lengths[:, None, None] * directions[None]).reshape(-1, 2)
+
+
+def shifted_support(
+    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+) -> tuple[np.ndarray, np.ndarray]:
+    """CoM references [M, 3] (world, m), and the configurations [M, 39] they are taken from, of
+    a single-support phase whose root moves horizontally, where no height profile over the
+    key posture's horizontal position reaches (`profiled_support` fails: a wide or long step
+    lands or lifts a sole beyond the legs' reach, or past the hip and ankle roll limits, from
+    a root held over the stance sole).
+
+    Arguments as `held_root_support`. The root moves by a shift s (horizontal, world) times
+    the contact weight (0 at the key posture, s at the contact end), its height along the
+    least-jerk profile inside what reaches (`profiled_configurations`); the shifts tried are
+    `shift_candidates` up to `config.root_shift`, shortest first, each with leg joints
+    LIMIT_MARGIN inside their limits, then 0. The first whose CoM stays at least
+    `config.single_support_margin` inside the stance sole at every sample is taken (the
+    upper body moves with the root, so the CoM moves with it). The CoM is that of those
+    configurations (the whole-body IK reproduces their roots).
+
+    Raises:
+        MotionError: no shift up to `config.root_shift` does (or it is 0).
+    """
+    import pinocchio as pin
+
+    if config.root_shift <= 0.0:
+        raise MotionError("the root does not move horizontally in single support (MotionConfig.root_shift)")
+    weight, knees, toward = single_support_schedule(talos, q, feet, swing, lifting, config)
+    stance = sole_corners(feet[0], np.arange(2) != swing)
+    data = talos.model.createData()
+    best = (-np.inf, None)  # (the CoM's least margin over the phase, shift) of the shifts that reach
+    for shift, margin in itertools.product(
+        shift_candidates(config.root_shift, ROOT_SHIFT_STEP, toward), (LIMIT_MARGIN, 0.0)
+    ):
+        configurations, _ = profiled_configurations(
+            talos, q, feet, rotations, weight[:, None] * shift, knees, weight, margin
+        )
+        if configurations is None:
+            continue
+        coms = np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations])
+        least = float(support_margins(stance, coms[:, :2]).min())
+        if least >= config.single_support_margin:
+            return coms, configurations
+        best = max(best, (least, tuple(np.round(shift, 3))), key=lambda pair: pair[0])
+    found = (
+        f"; the best, a {np.hypot(*best[1]):.2f} m shift, keeps it {best[0] * 100:.1f} cm inside"
+        if best[1] is not None
+        else ""
+    )
+    raise MotionError(
+        f"no root shift up to {config.root_shift:g} m keeps the CoM {config.single_support_margin * 100:g} cm "
+        f"inside the stance sole with the soles in reach{found}"
     )
 
 
@@ -710,33 +794,67 @@ def dip_profile(low: np.ndarray, high: np.ndarray, weight: np.ndarray) -> np.nda
     under 1e-3, around the key posture, keep the root (0, which must be inside their bounds),
     and the three samples at the contact end are held level: the root starts and ends the
     phase at rest.
+
+    Over PROFILE_KNOTS samples (a phase lengthened for its CoM's acceleration), the profile
+    is solved at PROFILE_KNOTS evenly spread samples, each bounded by the bounds of every
+    sample between its two neighbours, and interpolated between them by monotone cubic
+    pieces (`scipy.interpolate.PchipInterpolator`): each piece lies between its two ends,
+    both inside the bounds of the samples it spans. The dense solve's cost grows with the
+    cube of the samples (hpp_stairs_0's lift 84 -> 85, 2 027 samples: 25 s); a profile
+    solved at fewer samples is rougher (a 6 s landing in tests/test_motion_shift.py peaks at
+    2.1 m/s^2, the same bounds solved at every sample at 0.1 m/s^2), still gentler than at
+    the phase's nominal length.
     """
-    from scipy.optimize import lsq_linear
+    from scipy.interpolate import PchipInterpolator
 
     room = np.minimum(DIP_INSET * weight, 0.5 * (high - low))
     lower, upper = low + room, high - room
     key = weight < 1e-3
     lower[key], upper[key] = -1e-12, 1e-12
     m = len(weight)
+    if m > PROFILE_KNOTS:
+        knots = np.unique(np.round(np.linspace(0, m - 1, PROFILE_KNOTS)).astype(int))
+        spans = zip(np.r_[knots[0], knots[:-1]], np.r_[knots[1:], knots[-1]])
+        coarse_lower = np.array([lower[a : b + 1].max() for a, b in spans])
+        spans = zip(np.r_[knots[0], knots[:-1]], np.r_[knots[1:], knots[-1]])
+        coarse_upper = np.array([upper[a : b + 1].min() for a, b in spans])
+        if (coarse_lower <= coarse_upper).all():
+            coarse = _least_jerk(coarse_lower, coarse_upper, weight[-1] > weight[0])
+            return np.clip(PchipInterpolator(knots, coarse)(np.arange(m)), low, high)
+    return np.clip(_least_jerk(lower, upper, weight[-1] > weight[0]), low, high)
+
+
+def _least_jerk(lower: np.ndarray, upper: np.ndarray, rest_at_end: bool) -> np.ndarray:
+    """Values [M] within lower [M] and upper [M] with the least squared third differences,
+    the three at one end (the last where rest_at_end, else the first) equal; by bounded least
+    squares (`dip_profile`)."""
+    from scipy.optimize import lsq_linear
+
+    m = len(lower)
     third = np.zeros((m - 3, m))
     for offset, value in enumerate((-1.0, 3.0, -3.0, 1.0)):
         third[np.arange(m - 3), np.arange(m - 3) + offset] = value
     # rest at the contact end too (the shift around the phase starts or ends there at rest):
     # its last three samples' lowering equal, weighted far above the jerk
     rest = np.zeros((2, m))
-    end = m - 3 if weight[-1] > weight[0] else 0
+    end = m - 3 if rest_at_end else 0
     rest[0, end : end + 2] = rest[1, end + 1 : end + 3] = (1e3, -1e3)
     system = np.vstack([third, rest, 1e-7 * np.eye(m)])
-    result = lsq_linear(system, np.zeros(len(system)), bounds=(lower, upper), method="bvls")
-    return np.clip(result.x, low, high)
+    return lsq_linear(system, np.zeros(len(system)), bounds=(lower, upper), method="bvls").x
 
 
 def support_margin(points: np.ndarray, point: np.ndarray) -> float:
     """Signed distance, m, of point [2] inside the convex hull of points [P, 2] (negative outside)."""
+    return float(support_margins(points, np.asarray(point)[None, :2])[0])
+
+
+def support_margins(points: np.ndarray, queries: np.ndarray) -> np.ndarray:
+    """Signed distances [N], m, of queries [N, 2] inside the convex hull of points [P, 2]
+    (negative outside)."""
     from scipy.spatial import ConvexHull
 
     hull = ConvexHull(points)
-    return float(-(hull.equations[:, :2] @ point + hull.equations[:, 2]).max())
+    return -(queries @ hull.equations[:, :2].T + hull.equations[:, 2]).max(axis=1)
 
 
 def sole_corners(feet: np.ndarray, on) -> np.ndarray:
@@ -948,23 +1066,29 @@ def speed_samples(configurations: np.ndarray, samples: int, speeds: np.ndarray, 
 def _single_support_coms(
     talos, spec: _PhaseSpec, k: int, config: MotionConfig
 ) -> tuple[np.ndarray, np.ndarray, bool]:
-    """`held_root_support`'s CoMs [n + 1, 3] and configurations [n + 1, 39] of a lift or land
-    spec's samples 0..n, else `profiled_support`'s, and whether the latter made them
-    (MotionError naming postures k and k + 1 and both reasons)."""
+    """CoMs [n + 1, 3] and configurations [n + 1, 39] of a lift or land spec's samples 0..n:
+    `held_root_support`'s, else `profiled_support`'s, else `shifted_support`'s; and whether
+    a height profile (either of the latter) made them.
+
+    Raises:
+        MotionError: naming postures k and k + 1 and the three reasons.
+    """
     from leas_jax.motion.paths import slerp
 
     fractions = np.arange(spec.samples + 1) / spec.samples
     feet = swing_feet(spec, fractions)
     rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config)
-    try:
-        return *held_root_support(*arguments), False
-    except MotionError as exc:
-        held = exc
-    try:
-        return *profiled_support(*arguments), True
-    except MotionError as exc:
-        raise MotionError(f"postures {k} and {k + 1}: {spec.kind}: {held}; sample by sample: {exc}") from None
+    reasons = []
+    for builder in (held_root_support, profiled_support, shifted_support):
+        try:
+            return *builder(*arguments), builder is not held_root_support
+        except MotionError as exc:
+            reasons.append(str(exc))
+    held, profiled, shifted = reasons
+    raise MotionError(
+        f"postures {k} and {k + 1}: {spec.kind}: {held}; sample by sample: {profiled}; shifting the root: {shifted}"
+    )
 
 
 def turn_scaling(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:

@@ -1,0 +1,98 @@
+"""Single support where no root height over the key posture reaches: the root moves
+horizontally too (`shifted_support`), the CoM kept inside the stance sole; and long phases'
+height profiles solved at fewer samples (`dip_profile`)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from motion_helpers import straight_plan
+
+from leas_jax.contacts.robot.model import load_talos
+from leas_jax.motion import motion
+from leas_jax.motion.config import MotionConfig
+from leas_jax.motion.motion import (
+    MotionError,
+    contact_weight,
+    dip_profile,
+    held_root_support,
+    posture_frames,
+    profiled_support,
+    shift_candidates,
+    shifted_support,
+    sole_corners,
+    support_margins,
+)
+from leas_jax.motion.paths import LAND_WINDOWS, swing_path
+
+
+def wide_landing(talos, outward: float):
+    """A landing of the left sole `outward` m to the left of its place in straight_plan's first
+    one-foot posture, on flat ground: (q [39], feet [81, 2, 4, 4], rotations [81, 3, 3])."""
+    q = straight_plan(0.3).q[1]
+    feet, _, rotation = posture_frames(talos, q)
+    start = feet[0][:3, 3]
+    end = start + np.r_[0.0, outward, 0.0]
+    path = np.repeat(feet[None], 81, axis=0)
+    path[:, 0, :3, 3] = swing_path(start, end, start[2] + 0.05, np.linspace(0.0, 1.0, 81), LAND_WINDOWS)
+    return q, path, np.repeat(rotation[None], 81, axis=0)
+
+
+def test_a_wide_landing_is_made_by_shifting_the_root_with_the_com_over_the_stance_sole():
+    """0.25 m outward: no root height over the key posture reaches the landing (the swing hip
+    and ankle roll past their limits), a root moved a few centimetres does; the CoM stays
+    `single_support_margin` inside the stance (right) sole and the key posture's root is kept."""
+    talos, config = load_talos(), MotionConfig()
+    q, feet, rotations = wide_landing(talos, 0.25)
+    with pytest.raises(MotionError):
+        held_root_support(talos, q, feet, rotations, 0, False, config)
+    with pytest.raises(MotionError):
+        profiled_support(talos, q, feet, rotations, 0, False, config)
+    coms, configurations = shifted_support(talos, q, feet, rotations, 0, False, config)
+    np.testing.assert_allclose(configurations[0][:3], q[:3], atol=1e-9)  # the key posture's root
+    shift = configurations[-1][:2] - q[:2]
+    assert 0.01 < np.linalg.norm(shift) <= config.root_shift + 1e-9
+    assert shift[1] > 0.0  # towards the swing sole (left, +y)
+    stance = sole_corners(feet[0], np.array([False, True]))
+    assert support_margins(stance, coms[:, :2]).min() >= config.single_support_margin
+    with pytest.raises(MotionError, match="root_shift"):
+        shifted_support(talos, q, feet, rotations, 0, False, dataclasses.replace(config, root_shift=0.0))
+
+
+def test_a_landing_too_wide_for_any_shift_says_how_close_the_best_came():
+    talos, config = load_talos(), MotionConfig()
+    q, feet, rotations = wide_landing(talos, 0.25)
+    strict = dataclasses.replace(config, single_support_margin=0.2)  # wider than the 0.13 m sole
+    with pytest.raises(MotionError, match=r"keeps the CoM 20 cm inside .* the best, a 0\.\d\d m shift"):
+        shifted_support(talos, q, feet, rotations, 0, False, strict)
+
+
+def test_shift_candidates_go_shortest_first_towards_the_swing_sole_first():
+    candidates = shift_candidates(0.1, 0.02, np.array([0.0, 1.0]))
+    lengths = np.linalg.norm(candidates, axis=1)
+    assert len(candidates) == 40 and np.all(np.diff(lengths) > -1e-12)
+    np.testing.assert_allclose(lengths[[0, -1]], [0.02, 0.1])
+    np.testing.assert_allclose(candidates[0], [0.0, 0.02], atol=1e-12)
+    np.testing.assert_allclose(candidates[7], [0.0, -0.02], atol=1e-12)
+
+
+def test_a_long_phase_profile_is_solved_at_fewer_samples_and_stays_inside_its_bounds():
+    """A landing whose swing leg needs the root 8-10 cm higher in mid-swing and at most 1 cm
+    higher at its contact, lengthened to 6 s (600 samples, over PROFILE_KNOTS): inside every
+    bound, the key posture's samples at 0, at rest at the contact end, and gentler than the
+    same landing over 0.8 s solved at every sample (what lengthening a phase relies on)."""
+
+    def profile(samples: int) -> np.ndarray:
+        weight = contact_weight(samples, lifting=False)
+        t = np.linspace(0.0, 1.0, samples)
+        low = np.where(t < 0.8, -0.3, -0.01)
+        high = 0.03 - 0.13 * np.exp(-0.5 * ((t - 0.5) / 0.12) ** 2)
+        dips = dip_profile(low, high, weight)
+        assert np.all(dips >= low - 1e-12) and np.all(dips <= high + 1e-12)
+        assert np.all(np.abs(dips[weight < 1e-3]) < 1e-9)
+        assert np.ptp(dips[-3:]) < 1e-6 and dips.min() < -0.09
+        return dips
+
+    assert 600 > motion.PROFILE_KNOTS >= 81
+    peaks = [np.abs(np.diff(profile(samples), 2)).max() / 0.01**2 for samples in (81, 600)]  # m/s^2
+    assert peaks[1] < 0.5 * peaks[0], peaks

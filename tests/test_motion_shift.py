@@ -70,10 +70,10 @@ def test_a_landing_too_wide_for_any_shift_says_how_close_the_best_came():
 def test_shift_candidates_go_shortest_first_towards_the_swing_sole_first():
     candidates = shift_candidates(0.1, 0.02, np.array([0.0, 1.0]))
     lengths = np.linalg.norm(candidates, axis=1)
-    assert len(candidates) == 40 and np.all(np.diff(lengths) > -1e-12)
-    np.testing.assert_allclose(lengths[[0, -1]], [0.02, 0.1])
-    np.testing.assert_allclose(candidates[0], [0.0, 0.02], atol=1e-12)
-    np.testing.assert_allclose(candidates[7], [0.0, -0.02], atol=1e-12)
+    assert len(candidates) == 41 and np.all(np.diff(lengths) > -1e-12)
+    np.testing.assert_allclose(lengths[[0, 1, -1]], [0.0, 0.02, 0.1])
+    np.testing.assert_allclose(candidates[1], [0.0, 0.02], atol=1e-12)
+    np.testing.assert_allclose(candidates[8], [0.0, -0.02], atol=1e-12)
 
 
 def test_a_long_phase_profile_is_solved_at_fewer_samples_and_stays_inside_its_bounds():
@@ -96,3 +96,58 @@ def test_a_long_phase_profile_is_solved_at_fewer_samples_and_stays_inside_its_bo
     assert 600 > motion.PROFILE_KNOTS >= 81
     peaks = [np.abs(np.diff(profile(samples), 2)).max() / 0.01**2 for samples in (81, 600)]  # m/s^2
     assert peaks[1] < 0.5 * peaks[0], peaks
+
+
+def test_a_balanced_single_support_keeps_its_com_inside_where_the_held_root_leans_out():
+    """A landing 0.15 m lower and 0.1 m ahead with the held root leaning 9 cm along the stance
+    sole (`MotionConfig.lean`): its CoM comes within 3 cm of the sole's toe; made balanced,
+    the CoM stays `single_support_margin` inside at every sample."""
+    talos = load_talos()
+    config = dataclasses.replace(MotionConfig(), lean=0.09)
+    q = straight_plan(0.3).q[1]
+    feet, _, rotation = posture_frames(talos, q)
+    start = feet[0][:3, 3]
+    path = np.repeat(feet[None], 81, axis=0)
+    t = np.linspace(0.0, 1.0, 81)
+    path[:, 0, :3, 3] = swing_path(start, start + np.r_[0.1, 0.0, -0.15], start[2] + 0.05, t, LAND_WINDOWS)
+    rotations = np.repeat(rotation[None], 81, axis=0)
+    spec = motion._PhaseSpec(
+        "land", (1, 2), 0, 80, feet, path[-1], None, None, rotation, rotation, q, q, start[2] + 0.05
+    )
+    stance = sole_corners(feet, np.array([False, True]))
+    held = held_root_support(talos, q, path, rotations, 0, False, config)[0]
+    assert support_margins(stance, held[:, :2]).min() < config.single_support_margin
+    coms, _, profiled = motion._single_support_coms(talos, spec, 1, config, balanced=True)
+    assert profiled and support_margins(stance, coms[:, :2]).min() >= config.single_support_margin
+
+
+def test_a_single_support_failing_its_equilibrium_check_is_made_again_balanced(monkeypatch):
+    """make_motion makes a single support whose samples fail the equilibrium check once more
+    with `balanced` (only that segment), and keeps the second motion; with root_shift 0 it
+    does not, and the failure is reported."""
+    plan = straight_plan(0.3)
+    segments, checks = [], []
+    real_segment, real_check = motion._segment_phases, motion.check_motion
+
+    def segment(plan, k, frames, terrain, config, talos, balanced=False):
+        segments.append((k, balanced))
+        return real_segment(plan, k, frames, terrain, config, talos, balanced)
+
+    def check(made, config):
+        failures = real_check(made, config)
+        if not checks:  # the first motion: its first single support said to tip over
+            index = next(i for i, phase in enumerate(made.phases) if phase.single_support)
+            failures.append((made.phases[index].start + 1, index, "equilibrium", "robustness -1 < 0.0"))
+        checks.append(made)
+        return failures
+
+    monkeypatch.setattr(motion, "_segment_phases", segment)
+    monkeypatch.setattr(motion, "check_motion", check)
+    made = motion.make_motion(plan, check=False)
+    first = next(phase for phase in checks[0].phases if phase.single_support).postures[0]
+    assert len(checks) == 2 and made is checks[1] and made.failures == []
+    assert [k for k, balanced in segments if balanced] == [first]
+    assert len(segments) == 2 * (len(plan) - 1)
+    segments.clear(), checks.clear()
+    made = motion.make_motion(plan, dataclasses.replace(MotionConfig(), root_shift=0.0), check=False)
+    assert len(checks) == 1 and [f[2] for f in made.failures] == ["equilibrium"]

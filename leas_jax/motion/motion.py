@@ -658,14 +658,14 @@ def profiled_configurations(
 
 
 def shift_candidates(longest: float, step: float, toward: np.ndarray) -> np.ndarray:
-    """Horizontal root shifts [C, 2] (world, m) of `shifted_support`, shortest first: every
-    multiple of `step` up to `longest` in 8 directions 45 deg apart, those of one length in
-    decreasing alignment with toward [2] (a unit vector, world)."""
+    """Horizontal root shifts [C, 2] (world, m) of `shifted_support`, shortest first: none, then
+    every multiple of `step` up to `longest` in 8 directions 45 deg apart, those of one length
+    in decreasing alignment with toward [2] (a unit vector, world)."""
     lengths = np.arange(1, math.floor(longest / step + 1e-9) + 1) * step
     angles = np.arange(8) * (np.pi / 4)
     directions = np.c_[np.cos(angles), np.sin(angles)]
     directions = directions[np.argsort(-(directions @ toward), kind="stable")]
-    return (lengths[:, None, None] * directions[None]).reshape(-1, 2)
+    return np.r_[np.zeros((1, 2)), (lengths[:, None, None] * directions[None]).reshape(-1, 2)]
 
 
 def shifted_support(
@@ -680,7 +680,7 @@ def shifted_support(
     Arguments as `held_root_support`. The root moves by a shift s (horizontal, world) times
     the contact weight (0 at the key posture, s at the contact end), its height along the
     least-jerk profile inside what reaches (`profiled_configurations`); the shifts tried are
-    `shift_candidates` up to `config.root_shift`, shortest first, each with leg joints
+    `shift_candidates` up to `config.root_shift`, none first, each with leg joints
     LIMIT_MARGIN inside their limits, then 0. The first whose CoM stays at least
     `config.single_support_margin` inside the stance sole at every sample is taken (the
     upper body moves with the root, so the CoM moves with it). The CoM is that of those
@@ -917,7 +917,9 @@ def centred_postures(talos, plan: ContactPlan, frames, margin: float, ik) -> tup
     return q, moved
 
 
-def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) -> list[_PhaseSpec]:
+def _segment_phases(
+    plan, k: int, frames, terrain, config: MotionConfig, talos, balanced: bool = False
+) -> list[_PhaseSpec]:
     """Phases from plan posture k to k + 1.
 
     In single support the CoM follows `held_root_support` (the root held at the one-foot
@@ -927,6 +929,7 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) 
     Args:
         frames: list over postures of (feet [2, 4, 4], com [3], root rotation [3, 3]) by FK.
         talos: `load_talos()` (the single-support CoMs).
+        balanced: the single support's CoM kept inside the stance sole where `shifted_support` can.
 
     Raises:
         MotionError: the two postures differ in a way no phase sequence handles (both
@@ -967,7 +970,7 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) 
             "lift", (k, k + 1), swing, round(config.lift_duration / dt), feet_a, lifted, com_b, com_b,
             rot_a, rot_b, q_b, q_b, apex,
         )  # fmt: skip
-        lift, coms = _single_support(talos, lift, k, config)
+        lift, coms = _single_support(talos, lift, k, config, balanced)
         coms[-1] = com_b
         return [
             shift(feet_a, com_a, coms[0], rot_a, rot_a, q_a, q_b),
@@ -985,7 +988,7 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) 
             "land", (k, k + 1), swing, round(config.land_duration / dt), feet_a, landed, com_a, com_a,
             rot_a, rot_b, q_a, q_a, apex,
         )  # fmt: skip
-        land, coms = _single_support(talos, land, k, config)
+        land, coms = _single_support(talos, land, k, config, balanced)
         return [
             dataclasses.replace(land, com1=coms[-1], coms=coms[1:]),
             shift(feet_b, coms[-1], com_b, rot_b, rot_b, q_a, q_b),
@@ -996,7 +999,9 @@ def _segment_phases(plan, k: int, frames, terrain, config: MotionConfig, talos) 
     )
 
 
-def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tuple[_PhaseSpec, np.ndarray]:
+def _single_support(
+    talos, spec: _PhaseSpec, k: int, config: MotionConfig, balanced: bool = False
+) -> tuple[_PhaseSpec, np.ndarray]:
     """A lift or land spec, lengthened where its CoM moves far or fast or its joints turn fast,
     and its CoM references [n + 1, 3] of samples 0..n (`_single_support_coms`).
 
@@ -1005,7 +1010,7 @@ def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tu
     (`paths.shift_duration`) and the peak horizontal acceleration of its references
     (`stretched_samples`: where the root rises, the CoM follows the swing leg's own path, on
     the swing windows). The references are functions of normalised time, so a longer phase
-    has them slower; up to STRETCHES lengthenings.
+    has them slower; up to STRETCHES lengthenings. balanced: as `_single_support_coms`.
 
     Raises:
         MotionError: naming postures k and k + 1.
@@ -1014,7 +1019,7 @@ def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tu
 
     limit, dt = config.single_support_acceleration, config.dt
     speeds = talos.model.velocityLimit[6:] * config.velocity_ratio * SPEED_MARGIN
-    coms, configurations, profiled = _single_support_coms(talos, spec, k, config)
+    coms, configurations, profiled = _single_support_coms(talos, spec, k, config, balanced)
     for _ in range(STRETCHES):
         distance = float(np.linalg.norm(coms[-1] - coms[0]))
         seconds = shift_duration(distance, limit, spec.samples * dt, dt)
@@ -1026,7 +1031,7 @@ def _single_support(talos, spec: _PhaseSpec, k: int, config: MotionConfig) -> tu
         if samples <= spec.samples:
             break
         spec = dataclasses.replace(spec, samples=samples)
-        coms, configurations, profiled = _single_support_coms(talos, spec, k, config)
+        coms, configurations, profiled = _single_support_coms(talos, spec, k, config, balanced)
     return spec, coms
 
 
@@ -1064,11 +1069,12 @@ def speed_samples(configurations: np.ndarray, samples: int, speeds: np.ndarray, 
 
 
 def _single_support_coms(
-    talos, spec: _PhaseSpec, k: int, config: MotionConfig
+    talos, spec: _PhaseSpec, k: int, config: MotionConfig, balanced: bool = False
 ) -> tuple[np.ndarray, np.ndarray, bool]:
     """CoMs [n + 1, 3] and configurations [n + 1, 39] of a lift or land spec's samples 0..n:
-    `held_root_support`'s, else `profiled_support`'s, else `shifted_support`'s; and whether
-    a height profile (either of the latter) made them.
+    `held_root_support`'s, else `profiled_support`'s, else `shifted_support`'s (balanced:
+    the latter's first, whose CoM stays inside the stance sole); and whether a height profile
+    (either of the latter) made them.
 
     Raises:
         MotionError: naming postures k and k + 1 and the three reasons.
@@ -1079,6 +1085,11 @@ def _single_support_coms(
     feet = swing_feet(spec, fractions)
     rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config)
+    if balanced:
+        try:
+            return *shifted_support(*arguments), True
+        except MotionError:
+            pass  # made as before: its equilibrium check fails again and says so
     reasons = []
     for builder in (held_root_support, profiled_support, shifted_support):
         try:
@@ -1171,6 +1182,10 @@ def _swing_clearance(terrain, spec: _PhaseSpec, references, config: MotionConfig
 def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check: bool = True) -> Motion:
     """A whole-body motion through every key posture of `plan`, at rest at each.
 
+    A single support that fails the equilibrium check is made again once with its CoM kept
+    `config.single_support_margin` inside the stance sole (`shifted_support`, the shifts from
+    0 up); every other phase is made as before.
+
     Args:
         plan: the contact plan (at least 2 postures).
         config: timing, paths, IK and check settings.
@@ -1184,7 +1199,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
         MotionError: a phase cannot be made (the message names it and says why).
     """
     from leas_jax.contacts.robot.model import load_talos
-    from leas_jax.motion.wbik import IKError, WholeBodyIK
+    from leas_jax.motion.wbik import WholeBodyIK
     from leas_jax.terrain import loads_terrain
 
     if len(plan) < 2:
@@ -1198,9 +1213,38 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     if moved:
         plan = dataclasses.replace(plan, q=keys)
         frames = [posture_frames(talos, q) for q in plan.q]
-    specs = []
-    for k in range(len(plan) - 1):
-        specs.extend(_segment_phases(plan, k, frames, terrain, config, talos))
+    balanced = set()  # segments k whose single support keeps its CoM inside the stance sole
+    while True:
+        specs = []
+        for k in range(len(plan) - 1):
+            specs.extend(_segment_phases(plan, k, frames, terrain, config, talos, k in balanced))
+        motion = _sampled_motion(plan, original, moved, specs, frames, terrain, config, talos, ik)
+        failures = check_motion(motion, config)
+        unbalanced = {
+            motion.phases[index].postures[0]
+            for _, index, name, _ in failures
+            if name == "equilibrium" and motion.phases[index].single_support
+        }
+        if balanced or not unbalanced or config.root_shift <= 0.0:
+            break
+        balanced = unbalanced
+    if check and failures:
+        sample, index, name, message = failures[0]
+        raise MotionError(
+            f"{motion.phases[index].describe(config.dt)}: {name} fails at t = {sample * config.dt:.2f} s: {message}"
+            f" ({len(failures)} failing samples)"
+        )
+    motion.failures.extend(failures)
+    return motion
+
+
+def _sampled_motion(plan, original, moved, specs, frames, terrain, config: MotionConfig, talos, ik) -> Motion:
+    """The Motion of phase specs along plan (its key postures, centred) by whole-body IK,
+    sample by sample, with velocities, accelerations, torques and wrenches; original: the plan
+    as given (`Motion.plan_q`), moved: the key postures centred (`Motion.moved_keys`). Raises MotionError naming the phase whose swing meets the
+    terrain, whose IK fails or ends off the next key posture."""
+    from leas_jax.motion.wbik import IKError
+
     q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
     contact_samples.append(_contacts(plan, 0))
     phases, key_index = [], [0]
@@ -1238,7 +1282,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     v, a = _derivatives(talos.model, q, config.dt)
     tau, wrenches = _torques(talos, q, v, a, contact)
     feet = np.array([[_placement(f) for f in pair] for pair in feet_samples])
-    motion = Motion(
+    return Motion(
         time=np.arange(len(q)) * config.dt,
         q=q,
         v=v,
@@ -1256,15 +1300,6 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
         terrain=plan.terrain,
         dt=config.dt,
     )
-    failures = check_motion(motion, config)
-    if check and failures:
-        sample, index, name, message = failures[0]
-        raise MotionError(
-            f"{motion.phases[index].describe(config.dt)}: {name} fails at t = {sample * config.dt:.2f} s: {message}"
-            f" ({len(failures)} failing samples)"
-        )
-    motion.failures.extend(failures)
-    return motion
 
 
 def _ends_segment(specs: list, spec: _PhaseSpec) -> bool:

@@ -151,3 +151,14 @@ def test_a_single_support_failing_its_equilibrium_check_is_made_again_balanced(m
     segments.clear(), checks.clear()
     made = motion.make_motion(plan, dataclasses.replace(MotionConfig(), root_shift=0.0), check=False)
     assert len(checks) == 1 and [f[2] for f in made.failures] == ["equilibrium"]
+
+
+def test_a_long_profile_whose_fewer_samples_leave_no_room_is_solved_at_every_sample():
+    """Bounds 1 mm apart that move faster than a knot's span: the bounds of a knot's span
+    leave it no room, so the profile is solved at every sample, inside every bound."""
+    samples = 400
+    weight = contact_weight(samples, lifting=False)
+    high = 0.05 * np.sin(np.linspace(0.0, 40.0, samples)) * weight + 0.0005
+    low = high - 0.001
+    dips = dip_profile(low, high, weight)
+    assert np.all(dips >= low - 1e-12) and np.all(dips <= high + 1e-12)

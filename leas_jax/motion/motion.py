@@ -818,7 +818,7 @@ def dip_profile(low: np.ndarray, high: np.ndarray, weight: np.ndarray) -> np.nda
         coarse_lower = np.array([lower[a : b + 1].max() for a, b in spans])
         spans = zip(np.r_[knots[0], knots[:-1]], np.r_[knots[1:], knots[-1]])
         coarse_upper = np.array([upper[a : b + 1].min() for a, b in spans])
-        if (coarse_lower <= coarse_upper).all():
+        if (coarse_lower < coarse_upper).all():  # bounded least squares needs room at every knot
             coarse = _least_jerk(coarse_lower, coarse_upper, weight[-1] > weight[0])
             return np.clip(PchipInterpolator(knots, coarse)(np.arange(m)), low, high)
     return np.clip(_least_jerk(lower, upper, weight[-1] > weight[0]), low, high)
@@ -840,6 +840,7 @@ def _least_jerk(lower: np.ndarray, upper: np.ndarray, rest_at_end: bool) -> np.n
     end = m - 3 if rest_at_end else 0
     rest[0, end : end + 2] = rest[1, end + 1 : end + 3] = (1e3, -1e3)
     system = np.vstack([third, rest, 1e-7 * np.eye(m)])
+    upper = np.maximum(upper, lower + 1e-12)  # a sample bounded to one value (lsq_linear needs room)
     return lsq_linear(system, np.zeros(len(system)), bounds=(lower, upper), method="bvls").x
 
 

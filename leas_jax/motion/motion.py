@@ -681,7 +681,9 @@ def shifted_support(
     the contact weight (0 at the key posture, s at the contact end), its height along the
     least-jerk profile inside what reaches (`profiled_configurations`); the shifts tried are
     `shift_candidates` up to `config.root_shift`, none first, each with leg joints
-    LIMIT_MARGIN inside their limits, then 0. The first whose CoM stays at least
+    LIMIT_MARGIN inside their limits, then 0; a shift is profiled only where its contact end
+    alone reaches with the CoM inside at the height nearest the key posture's. The first
+    whose CoM stays at least
     `config.single_support_margin` inside the stance sole at every sample is taken (the
     upper body moves with the root, so the CoM moves with it). The CoM is that of those
     configurations (the whole-body IK reproduces their roots).
@@ -697,9 +699,25 @@ def shifted_support(
     stance = sole_corners(feet[0], np.arange(2) != swing)
     data = talos.model.createData()
     best = (-np.inf, None)  # (the CoM's least margin over the phase, shift) of the shifts that reach
+    end = 0 if lifting else len(feet) - 1  # the contact end, where the root is shifted most
     for shift, margin in itertools.product(
         shift_candidates(config.root_shift, ROOT_SHIFT_STEP, toward), (LIMIT_MARGIN, 0.0)
     ):
+        # first the contact end alone (a whole phase's profile costs its length in such
+        # searches): its soles reached, its CoM inside at the height nearest the key posture's
+        low, high = reach_interval(talos, q, feet[end], rotations[end], shift, knees[end], margin)
+        if np.isnan(low):
+            continue
+        offset = np.r_[shift, -min(max(0.0, low), high)]
+        configuration = held_root_configuration(
+            talos, q, feet[end], rotations[end], offset, knees[end], margin
+        )
+        if configuration is None:
+            continue
+        com = pin.centerOfMass(talos.model, data, configuration, False)
+        if support_margins(stance, com[None, :2])[0] < config.single_support_margin:
+            best = max(best, (float(support_margins(stance, com[None, :2])[0]), tuple(np.round(shift, 3))))
+            continue
         configurations, _ = profiled_configurations(
             talos, q, feet, rotations, weight[:, None] * shift, knees, weight, margin
         )
@@ -709,7 +727,7 @@ def shifted_support(
         least = float(support_margins(stance, coms[:, :2]).min())
         if least >= config.single_support_margin:
             return coms, configurations
-        best = max(best, (least, tuple(np.round(shift, 3))), key=lambda pair: pair[0])
+        best = max(best, (least, tuple(np.round(shift, 3))))
     found = (
         f"; the best, a {np.hypot(*best[1]):.2f} m shift, keeps it {best[0] * 100:.1f} cm inside"
         if best[1] is not None

@@ -63,8 +63,15 @@ def test_a_landing_too_wide_for_any_shift_says_how_close_the_best_came():
     talos, config = load_talos(), MotionConfig()
     q, feet, rotations = wide_landing(talos, 0.25)
     strict = dataclasses.replace(config, single_support_margin=0.2)  # wider than the 0.13 m sole
-    with pytest.raises(MotionError, match=r"keeps the CoM 20 cm inside .* the best, a 0\.\d\d m shift"):
+    key = support_margins(
+        sole_corners(feet[0], np.array([False, True])), posture_frames(talos, q)[1][None, :2]
+    )
+    with pytest.raises(
+        MotionError, match=r"keeps the CoM ([\d.]+) cm inside .* the best, a 0\.\d\d m shift"
+    ) as error:
         shifted_support(talos, q, feet, rotations, 0, False, strict)
+    # as far inside as the key posture itself, where that is less than asked
+    assert abs(float(error.value.args[0].split("keeps the CoM ")[1].split(" cm")[0]) - 100 * key[0]) < 0.01
 
 
 def test_shift_candidates_go_shortest_first_towards_the_swing_sole_first():

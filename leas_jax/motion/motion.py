@@ -684,7 +684,9 @@ def shifted_support(
     LIMIT_MARGIN inside their limits, then 0; a shift is profiled only where its contact end
     alone reaches with the CoM inside at the height nearest the key posture's. The first
     whose CoM stays at least
-    `config.single_support_margin` inside the stance sole at every sample is taken (the
+    `config.single_support_margin` inside the stance sole at every sample (or as far as the
+    key posture's own, where that is less: the plan's one-foot postures may stand 2.96 cm
+    inside, hpp_rubble_1's 165) is taken (the
     upper body moves with the root, so the CoM moves with it). The CoM is that of those
     configurations (the whole-body IK reproduces their roots).
 
@@ -698,6 +700,8 @@ def shifted_support(
     weight, knees, toward = single_support_schedule(talos, q, feet, swing, lifting, config)
     stance = sole_corners(feet[0], np.arange(2) != swing)
     data = talos.model.createData()
+    key = support_margins(stance, pin.centerOfMass(talos.model, data, q, False)[None, :2])[0]
+    inside = min(config.single_support_margin, key - 1e-6)  # never less than the key posture's own
     best = (-np.inf, None)  # (the CoM's least margin over the phase, shift) of the shifts that reach
     end = 0 if lifting else len(feet) - 1  # the contact end, where the root is shifted most
     for shift, margin in itertools.product(
@@ -715,7 +719,7 @@ def shifted_support(
         if configuration is None:
             continue
         com = pin.centerOfMass(talos.model, data, configuration, False)
-        if support_margins(stance, com[None, :2])[0] < config.single_support_margin:
+        if support_margins(stance, com[None, :2])[0] < inside:
             best = max(best, (float(support_margins(stance, com[None, :2])[0]), tuple(np.round(shift, 3))))
             continue
         configurations, _ = profiled_configurations(
@@ -725,7 +729,7 @@ def shifted_support(
             continue
         coms = np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations])
         least = float(support_margins(stance, coms[:, :2]).min())
-        if least >= config.single_support_margin:
+        if least >= inside:
             return coms, configurations
         best = max(best, (least, tuple(np.round(shift, 3))))
     found = (
@@ -734,7 +738,7 @@ def shifted_support(
         else ""
     )
     raise MotionError(
-        f"no root shift up to {config.root_shift:g} m keeps the CoM {config.single_support_margin * 100:g} cm "
+        f"no root shift up to {config.root_shift:g} m keeps the CoM {inside * 100:.3g} cm "
         f"inside the stance sole with the soles in reach{found}"
     )
 

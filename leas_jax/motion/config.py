@@ -55,10 +55,13 @@ class MotionConfig:
     # sole lands or lifts beyond the legs' reach, or past the hip and ankle roll limits, from
     # the root over the stance sole), the root moves horizontally too, by up to `root_shift`,
     # m, on the contact weight, while the CoM stays `single_support_margin`, m, inside the
-    # stance sole at every sample (`motion.shifted_support`; the sole is 0.13 m wide, the key
-    # postures' CoMs some 6 cm inside it). Measured on navigate's plans of hpp_darpa,
-    # hpp_rubble, hpp_stairs and rubble-and-stairs scenes: a 0.10 m shift leaves 2.8-6.5 cm of
-    # margin at every sample of the phases that failed. 0: those phases fail as before.
+    # stance sole at every sample (`motion.shifted_support`; the sole is 0.13 m wide, the
+    # plan's one-foot postures' CoMs some 6 cm inside it). A single support that fails the
+    # equilibrium check is made that way once more. Measured on the 14 phases of navigate's
+    # rough-scene plans that no root height reached
+    # (docs/results/2026-12-06-motion-root-shift/room.py): with the root anywhere within
+    # 0.10 m horizontally, every sample of 10 of them reaches with the CoM 2.8-6.5 cm inside.
+    # 0: those phases fail as before, and no phase is made again.
     root_shift: float = 0.10
     single_support_margin: float = 0.03
     # Double-support key postures whose CoM lies closer than this to the edge of their soles'

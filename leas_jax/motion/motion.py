@@ -836,9 +836,8 @@ def dip_profile(low: np.ndarray, high: np.ndarray, weight: np.ndarray) -> np.nda
     m = len(weight)
     if m > PROFILE_KNOTS:
         knots = np.unique(np.round(np.linspace(0, m - 1, PROFILE_KNOTS)).astype(int))
-        spans = zip(np.r_[knots[0], knots[:-1]], np.r_[knots[1:], knots[-1]])
+        spans = list(zip(np.r_[knots[0], knots[:-1]], np.r_[knots[1:], knots[-1]]))  # neighbour to neighbour
         coarse_lower = np.array([lower[a : b + 1].max() for a, b in spans])
-        spans = zip(np.r_[knots[0], knots[:-1]], np.r_[knots[1:], knots[-1]])
         coarse_upper = np.array([upper[a : b + 1].min() for a, b in spans])
         if (coarse_lower < coarse_upper).all():  # bounded least squares needs room at every knot
             coarse = _least_jerk(coarse_lower, coarse_upper, weight[-1] > weight[0])
@@ -1206,8 +1205,8 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     """A whole-body motion through every key posture of `plan`, at rest at each.
 
     A single support that fails the equilibrium check is made again once with its CoM kept
-    `config.single_support_margin` inside the stance sole (`shifted_support`, the shifts from
-    0 up); every other phase is made as before.
+    inside the stance sole (`shifted_support`, the shifts from none up; where it cannot,
+    as before); every other phase is made as before.
 
     Args:
         plan: the contact plan (at least 2 postures).

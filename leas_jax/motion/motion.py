@@ -405,13 +405,10 @@ def held_root_configuration(
 
     out = np.array(q, dtype=np.float64)
     out[:3] += offset
-    out[3:7] = quat_xyzw_from_matrix(rotation)
-    root = np.eye(4)
-    root[:3, :3] = rotation
-    root[:3, 3] = out[:3]
     for side, leg in enumerate(talos.legs):
-        in_root = np.linalg.solve(root, feet[side])
-        joints = leg_ik_single(leg, in_root[:3, :3], in_root[:3, 3])
+        sole = feet[side]
+        # the sole in the root frame (the root's inverse is its rotation's transpose)
+        joints = leg_ik_single(leg, rotation.T @ sole[:3, :3], rotation.T @ (sole[:3, 3] - out[:3]))
         if joints is None or joints[3] < knees[side] - 1e-9:
             return None
         if margin > 0.0:
@@ -420,6 +417,7 @@ def held_root_configuration(
             if ((joints < lower) | (joints > upper)).any():
                 return None
         out[leg.q_index] = joints
+    out[3:7] = quat_xyzw_from_matrix(rotation)  # only where both legs reach: the searches' cost
     return out
 
 

@@ -717,8 +717,9 @@ def shifted_support(
         if configuration is None:
             continue
         com = pin.centerOfMass(talos.model, data, configuration, False)
-        if support_margins(stance, com[None, :2])[0] < inside:
-            best = max(best, (float(support_margins(stance, com[None, :2])[0]), tuple(np.round(shift, 3))))
+        at_end = float(support_margins(stance, com[None, :2])[0])
+        if at_end < inside:
+            best = max(best, (at_end, tuple(np.round(shift, 3))))
             continue
         configurations, _ = profiled_configurations(
             talos, q, feet, rotations, weight[:, None] * shift, knees, weight, margin

@@ -36,6 +36,9 @@ Rates come with 95 % Wilson intervals.
     python studies/motion_execution.py --out docs/results/2026-12-06-motion-every-scene --starts 2 \\
         --max-plans 2 --max-postures 1000 --variant new --scenarios circuit,hpp_darpa,hpp_talos_maze
 
+`--also VARIANT=JSON` simulates each motion once more with other SimulationConfig overrides
+(the motion made once), written as VARIANT.
+
 Writes <out>/motion_execution_<variant>.json and <out>/motion_execution_<variant>.md.
 
 Results: --out (default benchmarks/results/motion); the runs kept are docs/results/2026-12-06-motion/,
@@ -241,64 +244,82 @@ def cause(summary: dict) -> str:
 def run(args) -> dict:
     from leas_jax.contacts.commands import load_plan_file
     from leas_jax.motion.config import MotionConfig, SimulationConfig
-    from leas_jax.motion.execute import execute_plan
+    from leas_jax.motion.execute import Execution, execute_plan
+    from leas_jax.motion.simulate import simulate
 
     out = Path(args.out)
     cache = Path(args.plans)
     cache.mkdir(parents=True, exist_ok=True)
     motion_config = MotionConfig(**json.loads(args.motion_config))
-    simulation_config = SimulationConfig(**json.loads(args.simulation_config))
+    # (variant, SimulationConfig overrides): the first's simulation is execute_plan's, the
+    # others (--also) simulate the same motion again
+    variants = [(args.variant, json.loads(args.simulation_config))]
+    for item in args.also or []:
+        name, _, overrides = item.partition("=")
+        variants.append((name, json.loads(overrides or "{}")))
     names = list(TARGET) + (list(OTHERS) if args.all else [])
     if args.scenarios:
         names = args.scenarios.split(",")
-    report = {
-        "question": __doc__.split("\n\n")[1].replace("\n", " "),
-        "variant": args.variant,
-        "motion_config": json.loads(args.motion_config),
-        "simulation_config": json.loads(args.simulation_config),
-        "starts": args.starts,
-        "ground_starts_per_cell": args.ground_starts,
-        "max_plans": args.max_plans,
-        "max_postures": args.max_postures,
-        "scenarios": {},
-    }
-    json_path = out / f"motion_execution_{args.variant}.json"
-    if json_path.is_file() and args.scenarios:  # a run of some scenarios adds to the variant's others
-        previous = json.loads(json_path.read_text())
-        report["scenarios"] = {k: v for k, v in previous["scenarios"].items() if k not in names}
-        for scenario in report["scenarios"].values():  # causes as this version names them
-            for e in scenario["executions"]:
-                e["cause"] = cause(e)
+    reports = {}
+    for variant, overrides in variants:
+        report = {
+            "question": __doc__.split("\n\n")[1].replace("\n", " "),
+            "variant": variant,
+            "motion_config": json.loads(args.motion_config),
+            "simulation_config": overrides,
+            "starts": args.starts,
+            "ground_starts_per_cell": args.ground_starts,
+            "max_plans": args.max_plans,
+            "max_postures": args.max_postures,
+            "scenarios": {},
+        }
+        json_path = out / f"motion_execution_{variant}.json"
+        if json_path.is_file() and args.scenarios:  # a run of some scenarios adds to the variant's others
+            previous = json.loads(json_path.read_text())
+            report["scenarios"] = {k: v for k, v in previous["scenarios"].items() if k not in names}
+            for scenario in report["scenarios"].values():  # causes as this version names them
+                for e in scenario["executions"]:
+                    e["cause"] = cause(e)
+        reports[variant] = report
     for name in names:
         plans = make_plans(name, args.starts, args.ground_starts, cache, args.checkpoint)
         if args.max_plans:
             plans = plans[: args.max_plans]
-        executions, skipped = [], []
+        executions, skipped = {variant: [] for variant, _ in variants}, []
         for path in plans:
             plan = load_plan_file(path)
             if args.max_postures and len(plan) > args.max_postures:  # not executed, not counted
                 skipped.append({"plan": path.name, "postures": len(plan)})
                 print(f"{name} {path.name}: skipped ({len(plan)} postures)", flush=True)
                 continue
-            s = execute_plan(plan, motion_config, simulation_config).summary()
-            s = {"plan": path.name, "postures": len(plan), "cause": None} | s
-            s["cause"] = cause(s)
-            executions.append(s)
-            print(
-                f"{name} {path.name}: {s['cause'] or 'executed'} ({s.get('message') or s['error']})",
-                flush=True,
-            )
+            first = execute_plan(plan, motion_config, SimulationConfig(**variants[0][1]))
+            for variant, overrides in variants:
+                execution = first
+                if variant != variants[0][0] and first.motion is not None:
+                    rollout = simulate(first.motion, config=SimulationConfig(**overrides))
+                    execution = Execution(
+                        first.motion, rollout, None, first.make_seconds, first.make_cpu_seconds
+                    )
+                s = {"plan": path.name, "postures": len(plan), "cause": None} | execution.summary()
+                s["cause"] = cause(s)
+                executions[variant].append(s)
+                print(
+                    f"{variant} {name} {path.name}: {s['cause'] or 'executed'} ({s.get('message') or s['error']})",
+                    flush=True,
+                )
         marker = json.loads((cache / f"{name}.json").read_text())
-        report["scenarios"][name] = {
-            "method": marker.get("method", "rblin"),
-            "starts": marker["starts"],
-            "verified_plans": len(marker["plans"]),
-            "executions": executions,
-        } | ({"skipped": skipped} if skipped else {})
-        report["summary"] = summarise(report["scenarios"])
-        json_path.write_text(json.dumps(report, indent=1))
-    (out / f"motion_execution_{args.variant}.md").write_text(markdown(report))
-    return report
+        for variant, report in reports.items():
+            report["scenarios"][name] = {
+                "method": marker.get("method", "rblin"),
+                "starts": marker["starts"],
+                "verified_plans": len(marker["plans"]),
+                "executions": executions[variant],
+            } | ({"skipped": skipped} if skipped else {})
+            report["summary"] = summarise(report["scenarios"])
+            (out / f"motion_execution_{variant}.json").write_text(json.dumps(report, indent=1))
+    for variant, report in reports.items():
+        (out / f"motion_execution_{variant}.md").write_text(markdown(report))
+    return reports[args.variant]
 
 
 def combine(args) -> dict:
@@ -468,6 +489,12 @@ def main(argv=None) -> int:
     )
     parser.add_argument("--motion-config", default="{}", help="JSON of MotionConfig overrides")
     parser.add_argument("--simulation-config", default="{}", help="JSON of SimulationConfig overrides")
+    parser.add_argument(
+        "--also",
+        action="append",
+        metavar="VARIANT=JSON",
+        help="also simulate each motion with these SimulationConfig overrides, written as VARIANT (repeatable)",
+    )
     args = parser.parse_args(argv)
     report = combine(args) if args.combine else run(args)
     print(markdown(report))

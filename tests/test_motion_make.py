@@ -101,6 +101,10 @@ def test_checks_catch_broken_motions(plan, motion):
     tau[80] *= 3.0
     names = {name for _, _, name, _ in check_motion(_replace(motion, tau=tau))}
     assert "inverse dynamics" in names
+    sunk = motion.q.copy()
+    sunk[60, 2] -= 0.1  # the whole robot 10 cm into the floor at one sample
+    failures = [(sample, name) for sample, _, name, _ in check_motion(_replace(motion, q=sunk))]
+    assert (60, "collisions") in failures and all(sample == 60 for sample, _ in failures)
     rushed = make_motion(
         plan, MotionConfig(min_double_support=0.1, com_acceleration=20.0, lift_duration=0.2, land_duration=0.25),
         check=False,

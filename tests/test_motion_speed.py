@@ -65,11 +65,11 @@ def test_a_high_landing_is_lengthened_for_its_knee_speed():
         feet_b[0][2, 3] + 0.3,
     )  # fmt: skip
     ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
-    coms, _, _ = _single_support_coms(talos, spec, k, config)
+    _, coms, _, _ = _single_support_coms(talos, spec, k, config)
     assert _peak_speed_ratio(talos, ik, dataclasses.replace(spec, coms=coms[1:]), plan.q[k], config.dt) > 1.0
     lengthened, coms = _single_support(talos, spec, k, config)
     assert lengthened.samples > samples
-    _, configurations, _ = _single_support_coms(talos, lengthened, k, config)
+    _, _, configurations, _ = _single_support_coms(talos, lengthened, k, config)
     limits = talos.model.velocityLimit[6:]
     assert (np.abs(np.diff(configurations[:, 7:], axis=0)) / config.dt / limits).max() <= SPEED_MARGIN + 1e-9
     assert (

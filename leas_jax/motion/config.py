@@ -64,6 +64,14 @@ class MotionConfig:
     # 0: those phases fail as before, and no phase is made again.
     root_shift: float = 0.10
     single_support_margin: float = 0.03
+    # Single-support configurations (held, profiled or shifted root) keep every geometry of
+    # Talos but the feet this far from the terrain, m, or as far as the plan's one-foot
+    # posture where it is closer (its postures are only collision-free): the first of those
+    # ways that does is taken. MuJoCo tracks the motion within 1-1.5 cm; the stance knee of
+    # a root lowered in front of a 0.20 m riser came within 2 mm of the next step's nosing on
+    # hpp_stairs and touched it in simulation (docs/results/2026-12-06-motion-clearance).
+    # 0: only the motion's collision check (every sample, `check_motion`) applies.
+    body_clearance: float = 0.01
     # Double-support key postures whose CoM lies closer than this to the edge of their soles'
     # support polygon (convex hull of both soles' corners, horizontal projection), m, are
     # reached with their CoM moved towards the polygon's centre until it is this far inside

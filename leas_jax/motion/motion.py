@@ -21,7 +21,11 @@ The static equilibria of a fixed set of contacts form a convex set of CoM positi
 a CoM moving straight between two of them stays in it. Every sample is then checked
 (`check_motion`): joint position and velocity limits, equilibrium robustness with the
 CoM's acceleration (hpp-centroidal-dynamics), joint torques from Pinocchio's rnea within
-the URDF's effort limits.
+the URDF's effort limits, collisions with the terrain and between the legs and the body
+(coal, as the verifier checks key postures; `clearance.BodyClearance`). Single supports are
+made clear of the terrain by a margin and of themselves (`MotionConfig.body_clearance`), the
+swing path bulging away from the stance leg where that needs it; the arms change between
+half-sitting and held in where their way is clear (`upper_body_window`, `tucked_arms`).
 """
 
 from __future__ import annotations
@@ -105,6 +109,19 @@ SPEED_MARGIN = 0.9
 # Root shifts tried in single support where no height profile reaches (`shifted_support`):
 # multiples of this, m, up to `MotionConfig.root_shift`.
 ROOT_SHIFT_STEP = 0.02
+# Index in a configuration [39] of the upper body's first joint (torso, arms, grippers, head):
+# 7 for the free flyer, 12 for the legs.
+UPPER_BODY = 19
+# Bulges of a single support's swing path away from the stance sole, m, tried in turn where
+# its configurations collide (`_single_support_coms`): the swing foot or shin passes the stance leg's on a
+# narrow bridge or a stair (eval_bridge, eval_stairs: a foot mesh against the other shin).
+SWING_OFFSETS = (0.04, 0.08)
+# The arms change between key postures over this fraction of a shift, at its start or end
+# (`upper_body_window`), the shift lengthened where their joints' speed needs it.
+UPPER_BODY_SPLIT = 0.5
+# Where no span of a shift clears their way, the change moves at most this many postures
+# earlier or later (`tucked_arms`).
+ARM_CHANGE_REACH = 4
 
 
 class MotionError(LeasError):
@@ -163,9 +180,11 @@ class Motion:
         plan_q: [K, 39], plan_feet: [K, 2, 7]: the plan's postures and placements.
         terrain: the terrain file's text.
         dt: sampling period, s.
-        moved_keys: [J] plan postures reached with their CoM moved inside the support polygon
-            (`MotionConfig.support_margin`, `centred_postures`): same soles, root orientation
-            and upper body, another root position and leg joints.
+        moved_keys: [J] plan postures reached otherwise: with their CoM moved inside the support
+            polygon (`MotionConfig.support_margin`, `centred_postures`: same soles, root
+            orientation and upper body, another root position and leg joints), or with the
+            arms of a neighbour where the arms' change moved (`tucked_arms`: same contacts,
+            root and legs).
     """
 
     time: np.ndarray
@@ -313,6 +332,10 @@ class _PhaseSpec:
         apex: m, height of the swing sole's path (`paths.swing_path`; NaN in a shift).
         coms: [samples, 3] CoM references of samples 1..n (single support), or None: straight
             from com0 to com1.
+        upper_window: (t0, t1), the span of normalised time over which the upper body goes
+            from upper0's to upper1's (`upper_body_window`).
+        swing_offset: m, the swing sole's path bulges this far away from the stance sole
+            (`swing_feet`).
     """
 
     kind: str
@@ -329,6 +352,8 @@ class _PhaseSpec:
     upper1: np.ndarray
     apex: float
     coms: np.ndarray | None = None
+    upper_window: tuple = (0.0, 1.0)
+    swing_offset: float = 0.0
 
 
 def _homogeneous(placement: np.ndarray) -> np.ndarray:
@@ -496,7 +521,14 @@ def single_support_schedule(talos, q: np.ndarray, feet: np.ndarray, swing: int, 
 
 
 def held_root_support(
-    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+    talos,
+    q: np.ndarray,
+    feet: np.ndarray,
+    rotations: np.ndarray,
+    swing: int,
+    lifting: bool,
+    config,
+    admissible=None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """CoM references [M, 3] (world, m) of a single-support phase's samples 0..M-1, and the
     configurations [M, 39] they are taken from.
@@ -523,8 +555,12 @@ def held_root_support(
     measured on eval_bridge, the blend put an ankle past its limit). Leg joints stay
     LIMIT_MARGIN inside their limits where that works.
 
+    admissible: configurations [M, 39] -> why they cannot be taken, or None (`_clear_of_terrain`);
+    None: any are.
+
     Raises:
-        MotionError: the soles are out of the legs' reach even MAX_DIP lower or MAX_RISE higher.
+        MotionError: the soles are out of the legs' reach even MAX_DIP lower or MAX_RISE higher,
+            or `admissible` refuses the configurations.
     """
     import pinocchio as pin
 
@@ -579,6 +615,9 @@ def held_root_support(
             configurations[i] = configuration
         if sign > 0:
             coms[:, :2] = lerp(coms[0, :2], coms[-1, :2], min_jerk(np.arange(len(feet)) / (len(feet) - 1)))
+        refused = admissible(configurations) if admissible else None
+        if refused:
+            raise MotionError(refused)
         return coms, configurations
 
     try:  # leg joints kept LIMIT_MARGIN inside their limits where that works
@@ -588,7 +627,14 @@ def held_root_support(
 
 
 def profiled_support(
-    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+    talos,
+    q: np.ndarray,
+    feet: np.ndarray,
+    rotations: np.ndarray,
+    swing: int,
+    lifting: bool,
+    config,
+    admissible=None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """CoM references [M, 3] (world, m), and the configurations [M, 39] they are taken from, of
     a single-support phase's samples 0..M-1 whose root
@@ -603,8 +649,8 @@ def profiled_support(
     of those configurations (no blend: the whole-body IK reproduces their roots).
 
     Raises:
-        MotionError: some sample's soles are out of reach at every height, or
-            `config.profiled_reach` is off.
+        MotionError: some sample's soles are out of reach at every height, `admissible` (as
+            `held_root_support`) refuses what reaches, or `config.profiled_reach` is off.
     """
     import pinocchio as pin
 
@@ -613,15 +659,20 @@ def profiled_support(
     weight, knees, toward = single_support_schedule(talos, q, feet, swing, lifting, config)
     data = talos.model.createData()
     lean = config.lean * weight[:, None] * toward
-    unreached = 0
+    unreached, refused = 0, None
     for shifts, margin in itertools.product((np.zeros((len(feet), 2)), lean), (LIMIT_MARGIN, 0.0)):
         configurations, unreached = profiled_configurations(
             talos, q, feet, rotations, shifts, knees, weight, margin
         )
-        if configurations is not None:
+        if configurations is None:
+            continue
+        refused = admissible(configurations) if admissible else None
+        if not refused:
             return np.array(
                 [pin.centerOfMass(talos.model, data, c, False) for c in configurations]
             ), configurations
+    if refused:
+        raise MotionError(refused)
     raise MotionError(
         f"at sample {unreached} the soles are out of the legs' reach at every root height from "
         f"{MAX_PROFILE_RISE:g} m higher to {MAX_DIP:g} m lower"
@@ -667,7 +718,14 @@ def shift_candidates(longest: float, step: float, toward: np.ndarray) -> np.ndar
 
 
 def shifted_support(
-    talos, q: np.ndarray, feet: np.ndarray, rotations: np.ndarray, swing: int, lifting: bool, config
+    talos,
+    q: np.ndarray,
+    feet: np.ndarray,
+    rotations: np.ndarray,
+    swing: int,
+    lifting: bool,
+    config,
+    admissible=None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """CoM references [M, 3] (world, m), and the configurations [M, 39] they are taken from, of
     a single-support phase whose root moves horizontally, where no height profile over the
@@ -686,7 +744,8 @@ def shifted_support(
     key posture's own, where that is less: the plan's one-foot postures may stand 2.96 cm
     inside, hpp_rubble_1's 165) is taken (the
     upper body moves with the root, so the CoM moves with it). The CoM is that of those
-    configurations (the whole-body IK reproduces their roots).
+    configurations (the whole-body IK reproduces their roots). Configurations that
+    `admissible` (as `held_root_support`) refuses are passed over.
 
     Raises:
         MotionError: no shift up to `config.root_shift` does (or it is 0).
@@ -701,6 +760,7 @@ def shifted_support(
     key = support_margins(stance, pin.centerOfMass(talos.model, data, q, False)[None, :2])[0]
     inside = min(config.single_support_margin, key - 1e-6)  # never less than the key posture's own
     best = (-np.inf, None)  # (the CoM's least margin over the phase, shift) of the shifts that reach
+    refused = None  # why `admissible` refused the last shift that kept the CoM inside
     end = 0 if lifting else len(feet) - 1  # the contact end, where the root is shifted most
     for shift, margin in itertools.product(
         shift_candidates(config.root_shift, ROOT_SHIFT_STEP, toward), (LIMIT_MARGIN, 0.0)
@@ -728,14 +788,19 @@ def shifted_support(
             continue
         coms = np.array([pin.centerOfMass(talos.model, data, c, False) for c in configurations])
         least = float(support_margins(stance, coms[:, :2]).min())
-        if least >= inside:
+        if least < inside:
+            best = max(best, (least, tuple(np.round(shift, 3))))
+            continue
+        refused = admissible(configurations) if admissible else None
+        if not refused:
             return coms, configurations
-        best = max(best, (least, tuple(np.round(shift, 3))))
     found = (
         f"; the best, a {np.hypot(*best[1]):.2f} m shift, keeps it {best[0] * 100:.1f} cm inside"
         if best[1] is not None
         else ""
     )
+    if refused:
+        found += f"; every shift that keeps it inside is refused, the last: {refused}"
     raise MotionError(
         f"no root shift up to {config.root_shift:g} m keeps the CoM {inside * 100:.3g} cm "
         f"inside the stance sole with the soles in reach{found}"
@@ -940,7 +1005,14 @@ def centred_postures(talos, plan: ContactPlan, frames, margin: float, ik) -> tup
 
 
 def _segment_phases(
-    plan, k: int, frames, terrain, config: MotionConfig, talos, balanced: bool = False
+    plan,
+    k: int,
+    frames,
+    terrain,
+    config: MotionConfig,
+    talos,
+    balanced: bool = False,
+    clearance=None,
 ) -> list[_PhaseSpec]:
     """Phases from plan posture k to k + 1.
 
@@ -952,6 +1024,7 @@ def _segment_phases(
         frames: list over postures of (feet [2, 4, 4], com [3], root rotation [3, 3]) by FK.
         talos: `load_talos()` (the single-support CoMs).
         balanced: the single support's CoM kept inside the stance sole where `shifted_support` can.
+        clearance: `BodyClearance` of the terrain, single supports kept clear of it (None: not checked).
 
     Raises:
         MotionError: the two postures differ in a way no phase sequence handles (both
@@ -969,9 +1042,17 @@ def _segment_phases(
         seconds = shift_duration(
             float(np.linalg.norm(com1 - com0)), config.com_acceleration, config.min_double_support, dt
         )
+        window = upper_body_window(clearance, q_a, q_b) or (0.0, 1.0)  # None: the check says where
+        # the upper body's minimum-jerk move inside its window keeps each joint within
+        # SPEED_MARGIN of its velocity limit (peak speed 1.875 x distance / duration)
+        speeds = (
+            talos.model.velocityLimit[UPPER_BODY - 1 :] * config.velocity_ratio * SPEED_MARGIN
+        )  # v: 6 root
+        turn = float((np.abs(upper1[UPPER_BODY:] - upper0[UPPER_BODY:]) / speeds).max())
+        seconds = max(seconds, math.ceil(1.875 * turn / (window[1] - window[0]) / dt - 1e-9) * dt)
         return _PhaseSpec(
             "shift", (k, k + 1), -1, round(seconds / dt), feet, feet, com0, com1, rot0, rot1, upper0, upper1,
-            float("nan"),
+            float("nan"), None, window,
         )  # fmt: skip
 
     if on_a.all() and on_b.all():
@@ -992,7 +1073,7 @@ def _segment_phases(
             "lift", (k, k + 1), swing, round(config.lift_duration / dt), feet_a, lifted, com_b, com_b,
             rot_a, rot_b, q_b, q_b, apex,
         )  # fmt: skip
-        lift, coms = _single_support(talos, lift, k, config, balanced)
+        lift, coms = _single_support(talos, lift, k, config, balanced, clearance)
         coms[-1] = com_b
         return [
             shift(feet_a, com_a, coms[0], rot_a, rot_a, q_a, q_b),
@@ -1010,7 +1091,7 @@ def _segment_phases(
             "land", (k, k + 1), swing, round(config.land_duration / dt), feet_a, landed, com_a, com_a,
             rot_a, rot_b, q_a, q_a, apex,
         )  # fmt: skip
-        land, coms = _single_support(talos, land, k, config, balanced)
+        land, coms = _single_support(talos, land, k, config, balanced, clearance)
         return [
             dataclasses.replace(land, com1=coms[-1], coms=coms[1:]),
             shift(feet_b, coms[-1], com_b, rot_b, rot_b, q_a, q_b),
@@ -1022,7 +1103,7 @@ def _segment_phases(
 
 
 def _single_support(
-    talos, spec: _PhaseSpec, k: int, config: MotionConfig, balanced: bool = False
+    talos, spec: _PhaseSpec, k: int, config: MotionConfig, balanced: bool = False, clearance=None
 ) -> tuple[_PhaseSpec, np.ndarray]:
     """A lift or land spec, lengthened where its CoM moves far or fast or its joints turn fast,
     and its CoM references [n + 1, 3] of samples 0..n (`_single_support_coms`).
@@ -1032,7 +1113,7 @@ def _single_support(
     (`paths.shift_duration`) and the peak horizontal acceleration of its references
     (`stretched_samples`: where the root rises, the CoM follows the swing leg's own path, on
     the swing windows). The references are functions of normalised time, so a longer phase
-    has them slower; up to STRETCHES lengthenings. balanced: as `_single_support_coms`.
+    has them slower; up to STRETCHES lengthenings. balanced, clearance: as `_single_support_coms`.
 
     Raises:
         MotionError: naming postures k and k + 1.
@@ -1041,7 +1122,7 @@ def _single_support(
 
     limit, dt = config.single_support_acceleration, config.dt
     speeds = talos.model.velocityLimit[6:] * config.velocity_ratio * SPEED_MARGIN
-    coms, configurations, profiled = _single_support_coms(talos, spec, k, config, balanced)
+    spec, coms, configurations, profiled = _single_support_coms(talos, spec, k, config, balanced, clearance)
     for _ in range(STRETCHES):
         distance = float(np.linalg.norm(coms[-1] - coms[0]))
         seconds = shift_duration(distance, limit, spec.samples * dt, dt)
@@ -1052,8 +1133,10 @@ def _single_support(
         )
         if samples <= spec.samples:
             break
-        spec = dataclasses.replace(spec, samples=samples)
-        coms, configurations, profiled = _single_support_coms(talos, spec, k, config, balanced)
+        spec = dataclasses.replace(spec, samples=samples, swing_offset=0.0)
+        spec, coms, configurations, profiled = _single_support_coms(
+            talos, spec, k, config, balanced, clearance
+        )
     return spec, coms
 
 
@@ -1091,37 +1174,127 @@ def speed_samples(configurations: np.ndarray, samples: int, speeds: np.ndarray, 
 
 
 def _single_support_coms(
-    talos, spec: _PhaseSpec, k: int, config: MotionConfig, balanced: bool = False
-) -> tuple[np.ndarray, np.ndarray, bool]:
-    """CoMs [n + 1, 3] and configurations [n + 1, 39] of a lift or land spec's samples 0..n:
-    `held_root_support`'s, else `profiled_support`'s, else `shifted_support`'s (balanced:
-    the latter's first, whose CoM stays inside the stance sole); and whether a height profile
-    (either of the latter) made them.
+    talos, spec: _PhaseSpec, k: int, config: MotionConfig, balanced: bool = False, clearance=None
+) -> tuple[_PhaseSpec, np.ndarray, np.ndarray, bool]:
+    """The spec with its swing path's bulge, CoMs [n + 1, 3] and configurations [n + 1, 39] of a
+    lift or land spec's samples 0..n: `held_root_support`'s, else `profiled_support`'s, else
+    `shifted_support`'s (balanced: the latter's first, whose CoM stays inside the stance sole);
+    and whether a height profile (either of the latter) made them.
+
+    Each is taken only where its configurations keep clear of the terrain and of themselves
+    (`_clear_of_terrain`; clearance: the `BodyClearance`, None: not checked); where none is,
+    the swing path bulges away from the stance sole by each of SWING_OFFSETS in turn.
 
     Raises:
-        MotionError: naming postures k and k + 1 and the three reasons.
+        MotionError: naming postures k and k + 1 and the three reasons (without a bulge).
     """
     from leas_jax.motion.paths import slerp
 
     fractions = np.arange(spec.samples + 1) / spec.samples
-    feet = swing_feet(spec, fractions)
     rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
-    arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config)
-    if balanced:
-        try:
-            return *shifted_support(*arguments), True
-        except MotionError:
-            pass  # made as before: its equilibrium check fails again and says so
-    reasons = []
-    for builder in (held_root_support, profiled_support, shifted_support):
-        try:
-            return *builder(*arguments), builder is not held_root_support
-        except MotionError as exc:
-            reasons.append(str(exc))
-    held, profiled, shifted = reasons
+    admissible = _clear_of_terrain(clearance, spec.upper0, config)
+    offsets = (0.0,) + (SWING_OFFSETS if admissible else ())
+    first = None  # the reasons without a bulge
+    for offset in offsets:
+        spec = dataclasses.replace(spec, swing_offset=offset)
+        feet = swing_feet(spec, fractions)
+        arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config, admissible)
+        if balanced:
+            try:
+                return spec, *shifted_support(*arguments), True
+            except MotionError:
+                pass  # made as before: its equilibrium check fails again and says so
+        reasons = []
+        for builder in (held_root_support, profiled_support, shifted_support):
+            try:
+                return spec, *builder(*arguments), builder is not held_root_support
+            except MotionError as exc:
+                reasons.append(str(exc))
+        first = first or reasons
+    held, profiled, shifted = first
     raise MotionError(
         f"postures {k} and {k + 1}: {spec.kind}: {held}; sample by sample: {profiled}; shifting the root: {shifted}"
     )
+
+
+def upper_body_window(clearance, q_a: np.ndarray, q_b: np.ndarray) -> tuple[float, float] | None:
+    """Span of a shift's normalised time over which its upper body goes from key posture q_a's
+    [39] to q_b's (the arms between half-sitting and held in); None where no span clears.
+
+    Over the whole shift, the arms can sweep through the terrain that both key postures
+    clear: the root moves towards a wall as the arms come in (hpp_talos_stairs15's shifts
+    beside the stair's wall). So the arms move in the first UPPER_BODY_SPLIT of the shift
+    where their whole path clears the terrain with the rest of the body as in q_a, else in
+    the last with the rest as in q_b (`arm_path_clear`); over the whole shift where the upper
+    body does not change or clearance is None.
+    """
+    if clearance is None or np.allclose(q_a[UPPER_BODY:], q_b[UPPER_BODY:]):
+        return (0.0, 1.0)
+    for span, body in (((0.0, UPPER_BODY_SPLIT), q_a), ((1.0 - UPPER_BODY_SPLIT, 1.0), q_b)):
+        if arm_path_clear(clearance, body, q_a, q_b):
+            return span
+    return None
+
+
+def arm_path_clear(clearance, body: np.ndarray, q_a: np.ndarray, q_b: np.ndarray) -> bool:
+    """Whether body [39] (root and legs) with its upper body going straight from q_a's to q_b's
+    (joint space, 11 points) collides nowhere (`BodyClearance.collisions`)."""
+    from leas_jax.motion.paths import lerp
+
+    path = np.repeat(body[None], 11, axis=0)
+    path[:, UPPER_BODY:] = lerp(q_a[UPPER_BODY:], q_b[UPPER_BODY:], np.linspace(0.0, 1.0, 11))
+    return all(clearance.collisions(q) is None for q in path)
+
+
+def tucked_arms(keys: np.ndarray, clearance) -> tuple[np.ndarray, list[int]]:
+    """Key postures [K, 39] whose upper body changes only where a shift can change it clear of
+    the terrain, and the postures changed.
+
+    Where the arms cannot change between postures k and k + 1 (`upper_body_window` None: a
+    wall beside the path that both postures clear, but not the arms' way between them), the
+    change moves to an earlier pair: postures k - j + 1..k take k + 1's upper body, for the
+    smallest j up to ARM_CHANGE_REACH whose postures stay collision-free and whose new pair
+    (k - j, k - j + 1) has a clear span; else to a later pair the same way. The plan's
+    postures hold the arms in where they must; holding them in longer, before or after,
+    changes no contact (the CoM moves by the arms' mass, which the motion's checks judge).
+    """
+    keys = np.array(keys, dtype=np.float64)
+    changed = set()
+    for k in range(len(keys) - 1):
+        if upper_body_window(clearance, keys[k], keys[k + 1]) is not None:
+            continue
+        for j, earlier in itertools.product(range(1, ARM_CHANGE_REACH + 1), (True, False)):
+            held = list(range(k - j + 1, k + 1)) if earlier else list(range(k + 1, k + j + 1))
+            source, pair = (keys[k + 1], (k - j, k - j + 1)) if earlier else (keys[k], (k + j, k + j + 1))
+            if min(pair) < 0 or max(pair) >= len(keys):
+                continue
+            trial = keys.copy()
+            trial[held, UPPER_BODY:] = source[UPPER_BODY:]
+            if any(clearance.collisions(trial[i]) for i in held):
+                continue
+            if upper_body_window(clearance, trial[pair[0]], trial[pair[1]]) is None:
+                continue
+            keys, changed = trial, changed | set(held)
+            break
+    return keys, sorted(changed)
+
+
+def _clear_of_terrain(clearance, q: np.ndarray, config: MotionConfig):
+    """The `admissible` test of a single support whose one-foot key posture is q [39]: it
+    refuses configurations [M, 39] in which a geometry other than the feet comes within
+    `config.body_clearance` of the terrain, or within the key posture's own distance where that
+    is less (the plan's postures are only collision-free), saying which and at what sample;
+    None where clearance is None or the margin is 0 (nothing refused)."""
+    if clearance is None or config.body_clearance <= 0.0:
+        return None
+    # the key posture itself passes: a tenth of a millimetre under its own distance
+    margin = max(min(config.body_clearance, clearance.distance(q, config.body_clearance)) - 1e-4, 0.0)
+
+    def admissible(configurations: np.ndarray) -> str | None:
+        found = clearance.first_too_close(configurations, margin)
+        return None if found is None else f"at sample {found[0]}, {found[1]}"
+
+    return admissible
 
 
 def turn_scaling(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
@@ -1140,7 +1313,8 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
     """Sole references [N, 2, 4, 4] (world) of a phase at normalised times fractions [N] in [0, 1].
 
     The swing sole follows `paths.swing_path` below spec.apex (LIFT_WINDOWS or
-    LAND_WINDOWS) and turns while it travels; at fraction 1 it is exactly at spec.feet1.
+    LAND_WINDOWS), bulging spec.swing_offset away from the stance sole, and turns while it
+    travels; at fraction 1 it is exactly at spec.feet1.
     """
     from leas_jax.motion.paths import LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
 
@@ -1149,9 +1323,23 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
         start, end = spec.feet0[spec.swing], spec.feet1[spec.swing]
         windows = LIFT_WINDOWS if spec.kind == "lift" else LAND_WINDOWS
         feet[:, spec.swing, :3, :3] = slerp(start[:3, :3], end[:3, :3], turn_scaling(spec, fractions))
-        feet[:, spec.swing, :3, 3] = swing_path(start[:3, 3], end[:3, 3], spec.apex, fractions, windows)
+        feet[:, spec.swing, :3, 3] = swing_path(
+            start[:3, 3], end[:3, 3], spec.apex, fractions, windows, spec.swing_offset, away_from_stance(spec)
+        )
         feet[np.asarray(fractions) >= 1.0, spec.swing] = spec.feet1[spec.swing]
     return feet
+
+
+def away_from_stance(spec: _PhaseSpec) -> np.ndarray:
+    """Horizontal unit vector [2] (world) square to a single support's swing travel, on the side
+    away from the stance sole (along the stance-to-swing direction where the sole does not travel)."""
+    start, end = spec.feet0[spec.swing][:2, 3], spec.feet1[spec.swing][:2, 3]
+    outward = 0.5 * (start + end) - spec.feet0[1 - spec.swing][:2, 3]
+    travel = end - start
+    if np.linalg.norm(travel) < 1e-3:
+        return outward / max(float(np.linalg.norm(outward)), 1e-9)
+    square = np.array([-travel[1], travel[0]]) / np.linalg.norm(travel)
+    return square if square @ outward >= 0.0 else -square
 
 
 def phase_references(spec: _PhaseSpec, dt: float):
@@ -1162,14 +1350,14 @@ def phase_references(spec: _PhaseSpec, dt: float):
     Returns:
         list of n wbik.Targets (feet [2, 4, 4], CoM [3], root rotation [3, 3], upper body [39]).
     """
-    from leas_jax.motion.paths import lerp, min_jerk, slerp
+    from leas_jax.motion.paths import lerp, min_jerk, slerp, window
     from leas_jax.motion.wbik import Targets
 
     fractions = np.arange(1, spec.samples + 1) / spec.samples
     s = min_jerk(fractions)
     coms = lerp(spec.com0, spec.com1, s) if spec.coms is None else spec.coms
     rots = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
-    uppers = lerp(spec.upper0, spec.upper1, s)
+    uppers = lerp(spec.upper0, spec.upper1, window(fractions, spec.upper_window))
     feet = swing_feet(spec, fractions)
     return [Targets(feet[i], coms[i], rots[i], uppers[i]) for i in range(spec.samples)]
 
@@ -1221,6 +1409,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
         MotionError: a phase cannot be made (the message names it and says why).
     """
     from leas_jax.contacts.robot.model import load_talos
+    from leas_jax.motion.clearance import BodyClearance
     from leas_jax.motion.wbik import WholeBodyIK
     from leas_jax.terrain import loads_terrain
 
@@ -1229,19 +1418,26 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     talos = load_talos()
     terrain = loads_terrain(plan.terrain, source="<plan terrain>")
     ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
+    clearance = BodyClearance(talos, terrain)
     original = plan
     frames = [posture_frames(talos, q) for q in plan.q]
     keys, moved = centred_postures(talos, plan, frames, config.support_margin, ik)
+    keys, tucked = tucked_arms(keys, clearance)
+    moved = sorted(set(moved) | set(tucked))
     if moved:
         plan = dataclasses.replace(plan, q=keys)
         frames = [posture_frames(talos, q) for q in plan.q]
     balanced = set()  # segments k whose single support keeps its CoM inside the stance sole
+    segments = {}  # (k, balanced): its phase specs, kept across the remake
     while True:
         specs = []
         for k in range(len(plan) - 1):
-            specs.extend(_segment_phases(plan, k, frames, terrain, config, talos, k in balanced))
+            key = (k, k in balanced)
+            if key not in segments:
+                segments[key] = _segment_phases(plan, k, frames, terrain, config, talos, key[1], clearance)
+            specs.extend(segments[key])
         motion = _sampled_motion(plan, original, moved, specs, frames, terrain, config, talos, ik)
-        failures = check_motion(motion, config)
+        failures = check_motion(motion, config, clearance)
         unbalanced = {
             motion.phases[index].postures[0]
             for _, index, name, _ in failures
@@ -1263,7 +1459,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
 def _sampled_motion(plan, original, moved, specs, frames, terrain, config: MotionConfig, talos, ik) -> Motion:
     """The Motion of phase specs along plan (its key postures, centred) by whole-body IK,
     sample by sample, with velocities, accelerations, torques and wrenches; original: the plan
-    as given (`Motion.plan_q`), moved: the key postures centred (`Motion.moved_keys`). Raises MotionError naming the phase whose swing meets the
+    as given (`Motion.plan_q`), moved: the key postures reached otherwise (`Motion.moved_keys`). Raises MotionError naming the phase whose swing meets the
     terrain, whose IK fails or ends off the next key posture."""
     from leas_jax.motion.wbik import IKError
 
@@ -1366,22 +1562,31 @@ def _torques(talos, q, v, a, contact) -> tuple[np.ndarray, np.ndarray]:
     return tau, wrenches
 
 
-def check_motion(motion: Motion, config: MotionConfig = MotionConfig()) -> list[tuple[int, int, str, str]]:
+def check_motion(
+    motion: Motion, config: MotionConfig = MotionConfig(), clearance=None
+) -> list[tuple[int, int, str, str]]:
     """Samples of a motion that fail a check.
 
     Checks at every sample: joint positions within the URDF's limits; joint velocities
     within `velocity_ratio` of the URDF's; static equilibrium with the CoM's acceleration
     (hpp-centroidal-dynamics robustness >= `min_robustness` over the sole corners in
     contact); joint torques within `torque_ratio` of the effort limits; the stored torques
-    equal to a fresh inverse dynamics of (q, v, a) (so edited torques are caught too).
+    equal to a fresh inverse dynamics of (q, v, a) (so edited torques are caught too); no
+    collision with the terrain or between the legs and the body, as the verifier checks key
+    postures (`clearance.BodyClearance.collisions`; clearance: one built on the motion's
+    terrain, else made here).
 
     Returns:
         list of (sample index, phase index, check name, message), in time order per check.
     """
     from leas_jax.contacts.robot.equilibrium import HppEquilibrium
     from leas_jax.contacts.robot.model import load_talos
+    from leas_jax.motion.clearance import BodyClearance
+    from leas_jax.terrain import loads_terrain
 
     talos = load_talos()
+    if clearance is None:
+        clearance = BodyClearance(talos, loads_terrain(motion.terrain, source="<motion terrain>"))
     model = talos.model
     lower, upper = model.lowerPositionLimit[7:], model.upperPositionLimit[7:]
     speed = model.velocityLimit[6:] * config.velocity_ratio
@@ -1417,6 +1622,9 @@ def check_motion(motion: Motion, config: MotionConfig = MotionConfig()) -> list[
         value = _robustness(solver, feet, motion.com[sample], acceleration[sample])
         if not value >= config.min_robustness:
             fail(sample, "equilibrium", f"robustness {value:.3g} < {config.min_robustness}")
+        collision = clearance.collisions(motion.q[sample])
+        if collision:
+            fail(sample, "collisions", collision)
     failures.sort(key=lambda item: item[0])
     return failures
 

@@ -47,22 +47,36 @@ def window(t, span: tuple[float, float]) -> np.ndarray:
     return min_jerk((np.asarray(t, dtype=np.float64) - t0) / (t1 - t0))
 
 
-def swing_path(start: np.ndarray, end: np.ndarray, apex: float, t, windows: tuple) -> np.ndarray:
+def swing_path(
+    start: np.ndarray,
+    end: np.ndarray,
+    apex: float,
+    t,
+    windows: tuple,
+    offset: float = 0.0,
+    away: np.ndarray | None = None,
+) -> np.ndarray:
     """Positions [N, 3] (world) of a swing sole at normalised times t [N] in [0, 1].
 
     The height rises from start's to `apex` in the rise window and comes down to end's in
     the descent window; the horizontal position moves from start's to end's in the travel
-    window. Every coordinate has zero velocity and acceleration at t = 0 and 1; the sole
+    window, bulging `offset` m along away [2] (a horizontal unit vector) at its middle
+    (16 p^2 (1 - p)^2 of the travel's progress p: no bulge, velocity or acceleration at its
+    ends). Every coordinate has zero velocity and acceleration at t = 0 and 1; the sole
     is at start at t = 0, at end at t = 1, and never above `apex`.
 
     Args:
         start, end: [3] sole positions, world; apex: m, at least both ends' heights.
         windows: (rise, travel, descend) spans, LIFT_WINDOWS or LAND_WINDOWS.
+        offset, away: the bulge, m, and its direction (unused where offset is 0).
     """
     rise, travel, descend = windows
     start, end = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64)
     out = np.empty((len(np.atleast_1d(t)), 3))
-    out[:, :2] = start[:2] + window(t, travel)[:, None] * (end[:2] - start[:2])
+    progress = window(t, travel)
+    out[:, :2] = start[:2] + progress[:, None] * (end[:2] - start[:2])
+    if offset:
+        out[:, :2] += (16.0 * offset * progress**2 * (1.0 - progress) ** 2)[:, None] * np.asarray(away)
     out[:, 2] = start[2] + (apex - start[2]) * window(t, rise) + (end[2] - apex) * window(t, descend)
     return out
 

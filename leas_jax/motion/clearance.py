@@ -1,0 +1,111 @@
+"""Collisions and terrain clearance of Talos's configurations along a motion (coal, host-only).
+
+A contact plan's key postures pass the verifier's collision check (`contacts.verify`, check
+3): every collision mesh of Talos against the terrain, the feet's raised by FOOT_CLEARANCE
+along the sole normal, and the legs against the rest of the body. `BodyClearance.collisions`
+applies that same check to any configuration of a motion. `BodyClearance.too_close` asks
+more of the geometries other than the feet: that they keep a margin from the terrain, which
+a tracked motion needs (MuJoCo's tracking error is 1-1.5 cm on the CoM; a stance knee that the
+planned motion brings within 2 mm of a stair's nosing touches it in simulation).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class BodyClearance:
+    """Talos's collision meshes against one terrain and against themselves.
+
+    Args:
+        talos: `load_talos()`.
+        terrain: the motion's terrain (boxes and meshes).
+    """
+
+    def __init__(self, talos, terrain):
+        from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
+
+        self.talos = talos
+        self.terrain = terrain
+        self.robot = robot_collision(talos)
+        self.objects = terrain_collision(terrain)
+        # geometries held to the margin: all but the two foot meshes, which rest on the terrain
+        self.spaced = np.array([g for g in range(len(self.robot.names)) if g not in talos.foot_geom_ids])
+        self._spaced_mask = np.isin(np.arange(len(self.robot.names)), self.spaced)
+
+    def _placements(self, q: np.ndarray):
+        rot, pos = self.robot.placements_pinocchio(self.talos, q)
+        return rot, pos, self.robot.world_aabb(rot, pos)
+
+    def _object_name(self, index: int) -> str:
+        boxes = len(self.terrain.boxes)
+        return f"terrain box {index}" if index < boxes else f"terrain mesh tile {index - boxes}"
+
+    def collisions(self, q: np.ndarray) -> str | None:
+        """What collides in configuration q [39] (the verifier's check), or None."""
+        rot, pos, aabb = self._placements(q)
+        for g, b in self.robot.terrain_contacts(rot, pos, self.objects, aabb=aabb):
+            return f"{self.robot.names[g]} collides with {self._object_name(b)}"
+        for ga, gb in self.robot.self_contacts(rot, pos, aabb=aabb):
+            return f"{self.robot.names[ga]} collides with {self.robot.names[gb]}"
+        return None
+
+    def distance(self, q: np.ndarray, reach: float) -> float:
+        """Least distance, m, from a geometry other than the feet to the terrain in q [39]; `reach`
+        where none is closer than that (0 or less: a collision)."""
+        import coal
+
+        rot, pos, aabb = self._placements(q)
+        request, result = coal.DistanceRequest(), coal.DistanceResult()
+        least = reach
+        for g in self.spaced:
+            for b in self.objects.boxes_near((aabb[g, 0] - reach).tolist(), (aabb[g, 1] + reach).tolist()):
+                result.clear()
+                value = coal.distance(
+                    self.robot.geometries[g],
+                    coal.Transform3s(rot[g], pos[g]),
+                    self.objects.shapes[b],
+                    self.objects.transforms[b],
+                    request,
+                    result,
+                )
+                least = min(least, value)
+        return least
+
+    def too_close(self, q: np.ndarray, margin: float) -> str | None:
+        """What keeps q [39] from being taken: a geometry other than the feet within `margin`, m,
+        of the terrain, a foot in it, or the legs against the body (`collisions`); None: nothing."""
+        import coal
+
+        rot, pos, aabb = self._placements(q)
+        reach = np.where(self._spaced_mask, margin, 0.0)  # [G]
+        grown = aabb + np.array([-1.0, 1.0])[None, :, None] * reach[:, None, None]
+        if len(self.objects.aabb):
+            near = self.objects.boxes_near(grown[:, 0].min(axis=0).tolist(), grown[:, 1].max(axis=0).tolist())
+            lo, hi = self.objects.aabb[near, 0], self.objects.aabb[near, 1]
+            overlap = np.all((grown[:, None, 0] <= hi[None]) & (grown[:, None, 1] >= lo[None]), axis=2)
+            request, result = coal.CollisionRequest(), coal.CollisionResult()
+            for g, k in zip(*np.nonzero(overlap)):
+                request.security_margin = float(reach[g])
+                result.clear()
+                b = near[k]
+                if coal.collide(
+                    self.robot.geometries[g],
+                    coal.Transform3s(rot[g], pos[g]),
+                    self.objects.shapes[b],
+                    self.objects.transforms[b],
+                    request,
+                    result,
+                ):
+                    return f"{self.robot.names[g]} comes within {reach[g] * 100:.3g} cm of {self._object_name(b)}"
+        for ga, gb in self.robot.self_contacts(rot, pos, aabb=aabb):
+            return f"{self.robot.names[ga]} collides with {self.robot.names[gb]}"
+        return None
+
+    def first_too_close(self, configurations: np.ndarray, margin: float) -> tuple[int, str] | None:
+        """(sample, `too_close`'s message) of the first of configurations [M, 39] refused, or None."""
+        for i, q in enumerate(configurations):
+            reason = self.too_close(q, margin)
+            if reason:
+                return i, reason
+        return None

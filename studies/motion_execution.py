@@ -211,6 +211,9 @@ def cause(summary: dict) -> str:
     if not summary["made"]:
         error = summary["error"] or ""
         for key, label in (
+            ("collisions fails", "collisions"),  # the motion's check, at a sample
+            ("comes within", "terrain clearance"),  # a single support's ways all refused
+            ("collides with", "collisions"),
             ("equilibrium", "equilibrium"),
             ("out of the legs' reach", "soles out of reach"),
             ("for the soles to reach", "soles out of reach"),

@@ -98,3 +98,18 @@ def test_combine_merges_variants_and_reports_skipped_plans(tmp_path):
     text = (tmp_path / "motion_execution_all.md").read_text()
     assert "hpp_talos_maze_0.npz (2145 postures)" in text
     assert "| hpp_cross_gap | navigate | 2 | 0 | - |" in text
+
+
+def test_motions_refused_for_collisions_are_named_so():
+    def refused(error):
+        return study.cause(_execution("p.npz", False, made=False, error=error))
+
+    lift = "postures 76 and 77: lift: at sample 0, leg_left_4_link_0 comes within 0.817 cm of terrain mesh tile 10"
+    assert refused(lift + "; sample by sample: ...") == "no motion: terrain clearance"
+    check = "shift between postures 24 and 25 (t = 18.9-20.4 s): collisions fails at t = 19.5 s: arm_right_5_link_0"
+    assert (
+        refused(check + " collides with terrain mesh tile 2 (40 failing samples)") == "no motion: collisions"
+    )
+    assert refused("postures 3 and 4: lift: at sample 21 the soles are out of the legs' reach") == (
+        "no motion: soles out of reach"
+    )

@@ -50,6 +50,21 @@ class BodyClearance:
             return f"{self.robot.names[ga]} collides with {self.robot.names[gb]}"
         return None
 
+    def _near_pairs(self, aabb: np.ndarray, reach: np.ndarray):
+        """(geometry g, terrain object b) pairs whose bounds, g's grown by reach [G] (m; NaN:
+        g left out), meet."""
+        kept = ~np.isnan(reach)
+        grown = aabb + np.array([-1.0, 1.0])[None, :, None] * np.where(kept, reach, 0.0)[:, None, None]
+        if not len(self.objects.aabb) or not kept.any():
+            return
+        near = self.objects.boxes_near(
+            grown[kept, 0].min(axis=0).tolist(), grown[kept, 1].max(axis=0).tolist()
+        )
+        lo, hi = self.objects.aabb[near, 0], self.objects.aabb[near, 1]
+        overlap = np.all((grown[:, None, 0] <= hi[None]) & (grown[:, None, 1] >= lo[None]), axis=2)
+        for g, k in zip(*np.nonzero(overlap & kept[:, None])):
+            yield int(g), int(near[k])
+
     def distance(self, q: np.ndarray, reach: float) -> float:
         """Least distance, m, from a geometry other than the feet to the terrain in q [39]; `reach`
         where none is closer than that (0 or less: a collision)."""
@@ -58,18 +73,18 @@ class BodyClearance:
         rot, pos, aabb = self._placements(q)
         request, result = coal.DistanceRequest(), coal.DistanceResult()
         least = reach
-        for g in self.spaced:
-            for b in self.objects.boxes_near((aabb[g, 0] - reach).tolist(), (aabb[g, 1] + reach).tolist()):
-                result.clear()
-                value = coal.distance(
-                    self.robot.geometries[g],
-                    coal.Transform3s(rot[g], pos[g]),
-                    self.objects.shapes[b],
-                    self.objects.transforms[b],
-                    request,
-                    result,
-                )
-                least = min(least, value)
+        for g, b in self._near_pairs(aabb, np.where(self._spaced_mask, reach, np.nan)):
+            result.clear()
+            tf = coal.Transform3s(rot[g], pos[g])
+            value = coal.distance(
+                self.robot.geometries[g],
+                tf,
+                self.objects.shapes[b],
+                self.objects.transforms[b],
+                request,
+                result,
+            )
+            least = min(least, value)
         return least
 
     def too_close(self, q: np.ndarray, margin: float) -> str | None:
@@ -79,25 +94,20 @@ class BodyClearance:
 
         rot, pos, aabb = self._placements(q)
         reach = np.where(self._spaced_mask, margin, 0.0)  # [G]
-        grown = aabb + np.array([-1.0, 1.0])[None, :, None] * reach[:, None, None]
-        if len(self.objects.aabb):
-            near = self.objects.boxes_near(grown[:, 0].min(axis=0).tolist(), grown[:, 1].max(axis=0).tolist())
-            lo, hi = self.objects.aabb[near, 0], self.objects.aabb[near, 1]
-            overlap = np.all((grown[:, None, 0] <= hi[None]) & (grown[:, None, 1] >= lo[None]), axis=2)
-            request, result = coal.CollisionRequest(), coal.CollisionResult()
-            for g, k in zip(*np.nonzero(overlap)):
-                request.security_margin = float(reach[g])
-                result.clear()
-                b = near[k]
-                if coal.collide(
-                    self.robot.geometries[g],
-                    coal.Transform3s(rot[g], pos[g]),
-                    self.objects.shapes[b],
-                    self.objects.transforms[b],
-                    request,
-                    result,
-                ):
-                    return f"{self.robot.names[g]} comes within {reach[g] * 100:.3g} cm of {self._object_name(b)}"
+        request, result = coal.CollisionRequest(), coal.CollisionResult()
+        for g, b in self._near_pairs(aabb, reach):
+            request.security_margin = float(reach[g])
+            result.clear()
+            tf = coal.Transform3s(rot[g], pos[g])
+            if coal.collide(
+                self.robot.geometries[g],
+                tf,
+                self.objects.shapes[b],
+                self.objects.transforms[b],
+                request,
+                result,
+            ):
+                return f"{self.robot.names[g]} comes within {reach[g] * 100:.3g} cm of {self._object_name(b)}"
         for ga, gb in self.robot.self_contacts(rot, pos, aabb=aabb):
             return f"{self.robot.names[ga]} collides with {self.robot.names[gb]}"
         return None

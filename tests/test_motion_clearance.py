@@ -126,16 +126,3 @@ def test_the_arms_change_where_their_way_is_clear():
     assert changed == [2]
     np.testing.assert_array_equal(tucked[:, motion.UPPER_BODY], [1, 1, 1, 0, 0])
     assert motion.upper_body_window(corridor, tucked[2], tucked[3]) == (1.0 - motion.UPPER_BODY_SPLIT, 1.0)
-
-
-def test_a_held_bulge_stays_out_until_its_span_back():
-    start, end = np.array([0.0, 0.1, 0.0]), np.array([0.3, 0.1, 0.0])
-    t = np.linspace(0.0, 1.0, 401)
-    away = np.array([0.0, 1.0])
-    plain = swing_path(start, end, 0.05, t, LAND_WINDOWS)
-    held = swing_path(start, end, 0.05, t, LAND_WINDOWS, 0.06, away, ((0.0, 0.35), (0.85, 1.0)))
-    side = held[:, 1] - plain[:, 1]
-    assert side[0] == side[-1] == 0.0
-    np.testing.assert_allclose(side[(t >= 0.35) & (t <= 0.85)], 0.06)  # held out in between
-    bump = swing_path(start, end, 0.05, t, LAND_WINDOWS, 0.06, away)[:, 1] - plain[:, 1]
-    assert side[t.searchsorted(0.8)] > 0.059 > 0.03 > bump[t.searchsorted(0.8)]  # the bump is coming back

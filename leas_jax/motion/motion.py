@@ -112,11 +112,13 @@ ROOT_SHIFT_STEP = 0.02
 # Index in a configuration [39] of the upper body's first joint (torso, arms, grippers, head):
 # 7 for the free flyer, 12 for the legs.
 UPPER_BODY = 19
-# Bulges of a single support's swing path away from the stance sole, (m, held), tried in turn
-# where its configurations collide (`_single_support_coms`): the swing foot or shin passes the
-# stance leg's on a narrow bridge or a stair (eval_stairs: a foot mesh against the other shin,
-# cleared by the 4 cm bump); held out (`paths.HELD_BULGES`) where a bump comes back too soon.
-SWING_OFFSETS = ((0.04, False), (0.08, False), (0.06, True), (0.10, True))
+# Bulges of a single support's swing path away from the stance sole, m, tried in turn where
+# its configurations collide (`_single_support_coms`): a swing foot passing the stance shin on a
+# stair (eval_stairs_0's landing 89 -> 90, cleared by one). Tried and dropped: a bulge
+# held out until the last of a landing's descent cleared eval_bridge's legs, but its swing
+# leg's weight held out took the stance ankle or hip roll to 1.07-1.08 x its effort limit
+# (docs/results/2026-12-06-motion-clearance).
+SWING_OFFSETS = (0.04, 0.08)
 # The arms change between key postures over this fraction of a shift, at its start or end
 # (`upper_body_window`), the shift lengthened where their joints' speed needs it.
 UPPER_BODY_SPLIT = 0.5
@@ -336,7 +338,7 @@ class _PhaseSpec:
         upper_window: (t0, t1), the span of normalised time over which the upper body goes
             from upper0's to upper1's (`upper_body_window`).
         swing_offset: m, the swing sole's path bulges this far away from the stance sole
-            (`swing_feet`); swing_held: the bulge held out (`paths.HELD_BULGES`), not a bump.
+            (`swing_feet`).
     """
 
     kind: str
@@ -355,7 +357,6 @@ class _PhaseSpec:
     coms: np.ndarray | None = None
     upper_window: tuple = (0.0, 1.0)
     swing_offset: float = 0.0
-    swing_held: bool = False
 
 
 def _homogeneous(placement: np.ndarray) -> np.ndarray:
@@ -1135,7 +1136,7 @@ def _single_support(
         )
         if samples <= spec.samples:
             break
-        spec = dataclasses.replace(spec, samples=samples, swing_offset=0.0, swing_held=False)
+        spec = dataclasses.replace(spec, samples=samples, swing_offset=0.0)
         spec, coms, configurations, profiled = _single_support_coms(
             talos, spec, k, config, balanced, clearance
         )
@@ -1195,10 +1196,10 @@ def _single_support_coms(
     fractions = np.arange(spec.samples + 1) / spec.samples
     rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     admissible = _clear_of_terrain(clearance, spec.upper0, config)
-    bulges = ((0.0, False),) + (SWING_OFFSETS if admissible else ())
+    offsets = (0.0,) + (SWING_OFFSETS if admissible else ())
     first = None  # the reasons without a bulge
-    for offset, held in bulges:
-        spec = dataclasses.replace(spec, swing_offset=offset, swing_held=held)
+    for offset in offsets:
+        spec = dataclasses.replace(spec, swing_offset=offset)
         feet = swing_feet(spec, fractions)
         arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config, admissible)
         if balanced:
@@ -1318,7 +1319,7 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
     LAND_WINDOWS), bulging spec.swing_offset away from the stance sole, and turns while it
     travels; at fraction 1 it is exactly at spec.feet1.
     """
-    from leas_jax.motion.paths import HELD_BULGES, LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
+    from leas_jax.motion.paths import LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
 
     feet = np.repeat(spec.feet0[None], len(fractions), axis=0)
     if spec.swing >= 0:
@@ -1326,14 +1327,7 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
         windows = LIFT_WINDOWS if spec.kind == "lift" else LAND_WINDOWS
         feet[:, spec.swing, :3, :3] = slerp(start[:3, :3], end[:3, :3], turn_scaling(spec, fractions))
         feet[:, spec.swing, :3, 3] = swing_path(
-            start[:3, 3],
-            end[:3, 3],
-            spec.apex,
-            fractions,
-            windows,
-            spec.swing_offset,
-            away_from_stance(spec),
-            HELD_BULGES[spec.kind] if spec.swing_held else None,
+            start[:3, 3], end[:3, 3], spec.apex, fractions, windows, spec.swing_offset, away_from_stance(spec)
         )
         feet[np.asarray(fractions) >= 1.0, spec.swing] = spec.feet1[spec.swing]
     return feet

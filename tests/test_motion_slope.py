@@ -51,7 +51,7 @@ def slope_plan(degrees: float):
 
 def test_the_noslip_solver_keeps_the_soles_on_a_slope():
     motion = make_motion(slope_plan(10.0))
-    creeping = simulate(motion, config=SimulationConfig(settle=1.5))
+    creeping = simulate(motion, config=SimulationConfig(settle=1.5, noslip_iterations=0))
     held = simulate(motion, config=SimulationConfig(settle=1.5, noslip_iterations=5))
     assert creeping.success and held.success, (creeping.message, held.message)
     # 2 s standing: 8.6 mm downhill with MuJoCo's default, 0.2 mm with the noslip solver

@@ -10,8 +10,10 @@ gains of `simulate.pd_gains`, as `simulate.simulate` does on CPU MuJoCo (the def
 judge: falls, landings, slip, torque and other terrain contacts are measured there). The
 model is `robot.scene_model`'s with one difference: only the sole boxes collide with the
 terrain, as MJX has no collisions for the links' cylinders and meshes; a motion that
-`simulate` passes touches the terrain with its soles alone, so the physics is the same.
-JAX's default float32 runs the steps (CPU MuJoCo: float64).
+`simulate` passes touches the terrain with its soles alone, so the physics is the same but
+for the noslip solver, which `simulate` runs by default (`SimulationConfig.noslip_iterations`)
+and the replay does not (MuJoCo's default, 0). JAX's default float32 runs the steps (CPU
+MuJoCo: float64).
 
 Host code builds the model and the padded input arrays; the rollout (`rollout_one`, vmapped
 by `replay`) is jitted JAX. Motions of different lengths are padded with their last sample,

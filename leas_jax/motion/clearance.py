@@ -29,17 +29,28 @@ class BodyClearance:
         self.terrain = terrain
         self.robot = robot_collision(talos)
         self.objects = terrain_collision(terrain)
-        # geometries held to the margin: all but the two foot meshes, which rest on the terrain
-        self.spaced = np.array([g for g in range(len(self.robot.names)) if g not in talos.foot_geom_ids])
-        self._spaced_mask = np.isin(np.arange(len(self.robot.names)), self.spaced)
+        # [G] geometries held to the margin: all but the two foot meshes, which rest on the terrain
+        self._spaced = ~np.isin(np.arange(len(self.robot.names)), talos.foot_geom_ids)
 
     def _placements(self, q: np.ndarray):
         rot, pos = self.robot.placements_pinocchio(self.talos, q)
         return rot, pos, self.robot.world_aabb(rot, pos)
 
     def _object_name(self, index: int) -> str:
-        boxes = len(self.terrain.boxes)
-        return f"terrain box {index}" if index < boxes else f"terrain mesh tile {index - boxes}"
+        from leas_jax.contacts.verify import _terrain_object
+
+        return _terrain_object(self.terrain, index)
+
+    def _pair(self, g: int, b: int, rot: np.ndarray, pos: np.ndarray) -> tuple:
+        """coal's arguments of geometry g at its placement (rot [G, 3, 3], pos [G, 3]) and terrain object b."""
+        import coal
+
+        return (
+            self.robot.geometries[g],
+            coal.Transform3s(rot[g], pos[g]),
+            self.objects.shapes[b],
+            self.objects.transforms[b],
+        )
 
     def collisions(self, q: np.ndarray) -> str | None:
         """What collides in configuration q [39] (the verifier's check), or None."""
@@ -73,18 +84,9 @@ class BodyClearance:
         rot, pos, aabb = self._placements(q)
         request, result = coal.DistanceRequest(), coal.DistanceResult()
         least = reach
-        for g, b in self._near_pairs(aabb, np.where(self._spaced_mask, reach, np.nan)):
+        for g, b in self._near_pairs(aabb, np.where(self._spaced, reach, np.nan)):
             result.clear()
-            tf = coal.Transform3s(rot[g], pos[g])
-            value = coal.distance(
-                self.robot.geometries[g],
-                tf,
-                self.objects.shapes[b],
-                self.objects.transforms[b],
-                request,
-                result,
-            )
-            least = min(least, value)
+            least = min(least, coal.distance(*self._pair(g, b, rot, pos), request, result))
         return least
 
     def too_close(self, q: np.ndarray, margin: float) -> str | None:
@@ -93,20 +95,12 @@ class BodyClearance:
         import coal
 
         rot, pos, aabb = self._placements(q)
-        reach = np.where(self._spaced_mask, margin, 0.0)  # [G]
+        reach = np.where(self._spaced, margin, 0.0)  # [G]
         request, result = coal.CollisionRequest(), coal.CollisionResult()
         for g, b in self._near_pairs(aabb, reach):
             request.security_margin = float(reach[g])
             result.clear()
-            tf = coal.Transform3s(rot[g], pos[g])
-            if coal.collide(
-                self.robot.geometries[g],
-                tf,
-                self.objects.shapes[b],
-                self.objects.transforms[b],
-                request,
-                result,
-            ):
+            if coal.collide(*self._pair(g, b, rot, pos), request, result):
                 return f"{self.robot.names[g]} comes within {reach[g] * 100:.3g} cm of {self._object_name(b)}"
         for ga, gb in self.robot.self_contacts(rot, pos, aabb=aabb):
             return f"{self.robot.names[ga]} collides with {self.robot.names[gb]}"

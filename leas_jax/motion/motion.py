@@ -1045,7 +1045,7 @@ def _segment_phases(
         seconds = shift_duration(
             float(np.linalg.norm(com1 - com0)), config.com_acceleration, config.min_double_support, dt
         )
-        window = upper_body_window(clearance, q_a, q_b) or (0.0, 1.0)  # None: the check says where
+        window = upper_body_window(clearance, upper0, upper1) or (0.0, 1.0)  # None: the check says where
         # the upper body's minimum-jerk move inside its window keeps each joint within
         # SPEED_MARGIN of its velocity limit (peak speed 1.875 x distance / duration)
         speeds = (

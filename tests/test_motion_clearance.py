@@ -6,7 +6,8 @@ import pytest
 from leas_jax.contacts.robot.model import load_talos
 from leas_jax.motion import motion
 from leas_jax.motion.clearance import BodyClearance
-from leas_jax.motion.paths import LAND_WINDOWS, swing_path
+from leas_jax.motion.config import MotionConfig
+from leas_jax.motion.paths import HELD_BULGES, LAND_WINDOWS, LIFT_WINDOWS, swing_path
 from leas_jax.terrain import loads_terrain
 
 FLOOR = """
@@ -73,6 +74,31 @@ def test_the_swing_path_bulges_away_at_mid_travel_and_not_at_its_ends():
     assert side[0] == side[-1] == 0.0 and abs(side.max() - 0.04) < 1e-4 and side.min() >= 0.0
     velocity = np.diff(side) / np.diff(t)
     assert abs(velocity[0]) < 1e-3 and abs(velocity[-1]) < 1e-3
+
+
+@pytest.mark.parametrize("kind, windows", [("lift", LIFT_WINDOWS), ("land", LAND_WINDOWS)])
+def test_a_held_bulge_is_out_while_the_legs_pass_within_its_acceleration(kind, windows):
+    """Held out over the middle of the phase (where a bump has come back), at rest at both
+    ends, and over `bulge_samples` its sideways acceleration stays within the config's."""
+    config = MotionConfig()
+    samples = motion.bulge_samples(kind, 0.07, config)
+    t = np.arange(samples + 1) / samples
+    start, end = np.array([0.0, 0.1, 0.0]), np.array([0.3, 0.1, 0.0])
+    plain = swing_path(start, end, 0.1, t, windows)
+    bump = swing_path(start, end, 0.1, t, windows, 0.07, np.array([0.0, 1.0]))[:, 1] - plain[:, 1]
+    held = (
+        swing_path(start, end, 0.1, t, windows, 0.07, np.array([0.0, 1.0]), HELD_BULGES[kind])[:, 1]
+        - plain[:, 1]
+    )
+    out, back = HELD_BULGES[kind]
+    between = (t >= out[1]) & (t <= back[0])
+    np.testing.assert_allclose(held[between], 0.07)
+    assert held[0] == 0.0 and abs(held[-1]) < 1e-12 and held.min() >= 0.0
+    assert (held[between] > bump[between] + 0.03).any()  # out where the bump is (nearly) back
+    acceleration = np.diff(held, 2) / config.dt**2
+    assert np.abs(acceleration).max() <= config.bulge_acceleration * 1.01
+    faster = motion.bulge_samples(kind, 0.07, MotionConfig(bulge_acceleration=4 * config.bulge_acceleration))
+    assert abs(faster - samples / 2) <= 1  # duration scales with acceleration^-1/2
 
 
 def test_the_bulge_points_away_from_the_stance_sole():

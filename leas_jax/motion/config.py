@@ -34,6 +34,11 @@ class MotionConfig:
     # foot's straight path and above both end placements, m (the plan's single-support
     # postures lift the foot 5-15 cm).
     swing_clearance: float = 0.05
+    # Where the swing path must bulge out while the legs pass the stance leg (a held bulge,
+    # `motion.SWING_BULGES`), its sideways peak acceleration, m/s^2: the phase lasts long
+    # enough. The swing leg (about 10 kg) swung out at 7.4 m/s^2 (10 cm in 0.28 s) took the
+    # stance ankle roll to 1.08 x its effort limit on eval_bridge.
+    bulge_acceleration: float = 2.0
     # Single support where the swing sole cannot reach its contact from the one-foot
     # posture's root (the plan stretches its legs to within a millimetre of their reach,
     # knees at 0.05 rad, on steps): towards the contact the root moves `lean` m towards it

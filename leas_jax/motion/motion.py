@@ -112,13 +112,15 @@ ROOT_SHIFT_STEP = 0.02
 # Index in a configuration [39] of the upper body's first joint (torso, arms, grippers, head):
 # 7 for the free flyer, 12 for the legs.
 UPPER_BODY = 19
-# Bulges of a single support's swing path away from the stance sole, m, tried in turn where
-# its configurations collide (`_single_support_coms`): a swing foot passing the stance shin on a
-# stair (eval_stairs_0's landing 89 -> 90, cleared by one). Tried and dropped: a bulge
-# held out until the last of a landing's descent cleared eval_bridge's legs, but its swing
-# leg's weight held out took the stance ankle or hip roll to 1.07-1.08 x its effort limit
+# Bulges of a single support's swing path away from the stance sole, (m, held), tried in turn
+# where its configurations collide (`_single_support_coms`): a bump over the travel window
+# (a swing foot passing the stance shin on a stair: eval_stairs_0's landing 89 -> 90, cleared
+# by the 4 cm one), then a bulge held out while the legs pass (`paths.HELD_BULGES`: feet
+# 11 cm apart on eval_bridge, whose shins and knees a bump leaves in contact), its phase
+# lengthened for `MotionConfig.bulge_acceleration`. Held out as fast as a bump, the swing
+# leg's sideways swing took the stance ankle or hip roll to 1.07-1.08 x its effort limit
 # (docs/results/2026-12-06-motion-clearance).
-SWING_OFFSETS = (0.04, 0.08)
+SWING_BULGES = ((0.04, False), (0.08, False), (0.04, True), (0.07, True), (0.10, True))
 # The arms change between key postures over this fraction of a shift, at its start or end
 # (`upper_body_window`), the shift lengthened where their joints' speed needs it.
 UPPER_BODY_SPLIT = 0.5
@@ -338,7 +340,7 @@ class _PhaseSpec:
         upper_window: (t0, t1), the span of normalised time over which the upper body goes
             from upper0's to upper1's (`upper_body_window`).
         swing_offset: m, the swing sole's path bulges this far away from the stance sole
-            (`swing_feet`).
+            (`swing_feet`); swing_held: the bulge held out while the legs pass, not a bump.
     """
 
     kind: str
@@ -357,6 +359,7 @@ class _PhaseSpec:
     coms: np.ndarray | None = None
     upper_window: tuple = (0.0, 1.0)
     swing_offset: float = 0.0
+    swing_held: bool = False
 
 
 def _homogeneous(placement: np.ndarray) -> np.ndarray:
@@ -1136,7 +1139,7 @@ def _single_support(
         )
         if samples <= spec.samples:
             break
-        spec = dataclasses.replace(spec, samples=samples, swing_offset=0.0)
+        spec = dataclasses.replace(spec, samples=samples, swing_offset=0.0, swing_held=False)
         spec, coms, configurations, profiled = _single_support_coms(
             talos, spec, k, config, balanced, clearance
         )
@@ -1186,20 +1189,22 @@ def _single_support_coms(
 
     Each is taken only where its configurations keep clear of the terrain and of themselves
     (`_clear_of_terrain`; clearance: the `BodyClearance`, None: not checked); where none is,
-    the swing path bulges away from the stance sole by each of SWING_OFFSETS in turn.
+    the swing path bulges away from the stance sole by each of SWING_BULGES in turn (a held
+    one over at least `bulge_samples`).
 
     Raises:
         MotionError: naming postures k and k + 1 and the three reasons (without a bulge).
     """
     from leas_jax.motion.paths import slerp
 
-    fractions = np.arange(spec.samples + 1) / spec.samples
-    rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     admissible = _clear_of_terrain(clearance, spec.upper0, config)
-    offsets = (0.0,) + (SWING_OFFSETS if admissible else ())
+    bulges = ((0.0, False),) + (SWING_BULGES if admissible else ())
     first = None  # the reasons without a bulge
-    for offset in offsets:
-        spec = dataclasses.replace(spec, swing_offset=offset)
+    for offset, held in bulges:
+        samples = max(spec.samples, bulge_samples(spec.kind, offset, config)) if held else spec.samples
+        spec = dataclasses.replace(spec, swing_offset=offset, swing_held=held, samples=samples)
+        fractions = np.arange(spec.samples + 1) / spec.samples
+        rotations = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
         feet = swing_feet(spec, fractions)
         arguments = (talos, spec.upper0, feet, rotations, spec.swing, spec.kind == "lift", config, admissible)
         if balanced:
@@ -1218,6 +1223,17 @@ def _single_support_coms(
     raise MotionError(
         f"postures {k} and {k + 1}: {spec.kind}: {held}; sample by sample: {profiled}; shifting the root: {shifted}"
     )
+
+
+def bulge_samples(kind: str, offset: float, config: MotionConfig) -> int:
+    """Samples of a lift or land whose swing sole's held bulge of `offset` m
+    (`paths.HELD_BULGES`) goes out and back with a peak sideways acceleration of at most
+    `config.bulge_acceleration`, m/s^2 (a minimum-jerk move over the shorter of its spans)."""
+    from leas_jax.motion.paths import HELD_BULGES, MIN_JERK_PEAK_ACCELERATION
+
+    span = min(t1 - t0 for t0, t1 in HELD_BULGES[kind])
+    seconds = math.sqrt(MIN_JERK_PEAK_ACCELERATION * offset / config.bulge_acceleration) / span
+    return math.ceil(seconds / config.dt - 1e-9)
 
 
 def upper_body_window(clearance, q_a: np.ndarray, q_b: np.ndarray) -> tuple[float, float] | None:
@@ -1316,10 +1332,11 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
     """Sole references [N, 2, 4, 4] (world) of a phase at normalised times fractions [N] in [0, 1].
 
     The swing sole follows `paths.swing_path` below spec.apex (LIFT_WINDOWS or
-    LAND_WINDOWS), bulging spec.swing_offset away from the stance sole, and turns while it
+    LAND_WINDOWS), bulging spec.swing_offset away from the stance sole (held out where
+    spec.swing_held), and turns while it
     travels; at fraction 1 it is exactly at spec.feet1.
     """
-    from leas_jax.motion.paths import LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
+    from leas_jax.motion.paths import HELD_BULGES, LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
 
     feet = np.repeat(spec.feet0[None], len(fractions), axis=0)
     if spec.swing >= 0:
@@ -1327,7 +1344,14 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
         windows = LIFT_WINDOWS if spec.kind == "lift" else LAND_WINDOWS
         feet[:, spec.swing, :3, :3] = slerp(start[:3, :3], end[:3, :3], turn_scaling(spec, fractions))
         feet[:, spec.swing, :3, 3] = swing_path(
-            start[:3, 3], end[:3, 3], spec.apex, fractions, windows, spec.swing_offset, away_from_stance(spec)
+            start[:3, 3],
+            end[:3, 3],
+            spec.apex,
+            fractions,
+            windows,
+            spec.swing_offset,
+            away_from_stance(spec),
+            HELD_BULGES[spec.kind] if spec.swing_held else None,
         )
         feet[np.asarray(fractions) >= 1.0, spec.swing] = spec.feet1[spec.swing]
     return feet

@@ -41,6 +41,15 @@ LIFT_WINDOWS = ((0.0, 0.5), (0.3, 1.0), (0.5, 1.0))
 LAND_WINDOWS = ((0.0, 0.7), (0.35, 0.85), (0.6, 1.0))
 
 
+# Spans (out, back) of normalised time of a held bulge (`swing_path`): where a swing foot
+# passes the stance leg close by (feet 11 cm apart on eval_bridge), a bump over the travel
+# window comes back while the swing shin is still beside the stance shin; a held bulge is out
+# before the knees pass and back once the sole is over its contact. A lift moves out while
+# its sole rises its first centimetres and comes back once high; a landing stays out until
+# the last of its descent.
+HELD_BULGES = {"lift": ((0.0, 0.2), (0.5, 1.0)), "land": ((0.0, 0.35), (0.85, 1.0))}
+
+
 def window(t, span: tuple[float, float]) -> np.ndarray:
     """Minimum-jerk progress in [0, 1] at normalised times t [N] of a move over span = (t0, t1)."""
     t0, t1 = span
@@ -55,6 +64,7 @@ def swing_path(
     windows: tuple,
     offset: float = 0.0,
     away: np.ndarray | None = None,
+    held: tuple | None = None,
 ) -> np.ndarray:
     """Positions [N, 3] (world) of a swing sole at normalised times t [N] in [0, 1].
 
@@ -62,13 +72,15 @@ def swing_path(
     the descent window; the horizontal position moves from start's to end's in the travel
     window, bulging `offset` m along away [2] (a horizontal unit vector) at its middle
     (16 p^2 (1 - p)^2 of the travel's progress p: no bulge, velocity or acceleration at its
-    ends). Every coordinate has zero velocity and acceleration at t = 0 and 1; the sole
-    is at start at t = 0, at end at t = 1, and never above `apex`.
+    ends), or, with held = (out, back) two spans of t, going out over the first and back over
+    the second (`bulge_profile`). Every coordinate has zero velocity and acceleration at
+    t = 0 and 1; the sole is at start at t = 0, at end at t = 1, and never above `apex`.
 
     Args:
         start, end: [3] sole positions, world; apex: m, at least both ends' heights.
         windows: (rise, travel, descend) spans, LIFT_WINDOWS or LAND_WINDOWS.
         offset, away: the bulge, m, and its direction (unused where offset is 0).
+        held: None (the bump), or the (out, back) spans of a held bulge (`HELD_BULGES`).
     """
     rise, travel, descend = windows
     start, end = np.asarray(start, dtype=np.float64), np.asarray(end, dtype=np.float64)
@@ -76,9 +88,21 @@ def swing_path(
     progress = window(t, travel)
     out[:, :2] = start[:2] + progress[:, None] * (end[:2] - start[:2])
     if offset:
-        out[:, :2] += (16.0 * offset * progress**2 * (1.0 - progress) ** 2)[:, None] * np.asarray(away)
+        out[:, :2] += (offset * bulge_profile(t, travel, held))[:, None] * np.asarray(away)
     out[:, 2] = start[2] + (apex - start[2]) * window(t, rise) + (end[2] - apex) * window(t, descend)
     return out
+
+
+def bulge_profile(t, travel: tuple[float, float], held: tuple | None = None) -> np.ndarray:
+    """Fraction [N] in [0, 1] of a swing bulge at normalised times t [N]: the bump
+    16 p^2 (1 - p)^2 of the travel window's progress p (1 at its middle), or a held bulge
+    going out over held[0] and back over held[1] (1 in between); zero velocity and
+    acceleration at its ends either way."""
+    if held is None:
+        progress = window(t, travel)
+        return 16.0 * progress**2 * (1.0 - progress) ** 2
+    out, back = held
+    return window(t, out) * (1.0 - window(t, back))
 
 
 def slerp(rot0: np.ndarray, rot1: np.ndarray, s) -> np.ndarray:

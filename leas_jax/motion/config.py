@@ -36,8 +36,9 @@ class MotionConfig:
     swing_clearance: float = 0.05
     # Where the swing path must bulge out while the legs pass the stance leg (a held bulge,
     # `motion.SWING_BULGES`), its sideways peak acceleration, m/s^2: the phase lasts long
-    # enough. The swing leg (about 10 kg) swung out at 7.4 m/s^2 (10 cm in 0.28 s) took the
-    # stance ankle roll to 1.08 x its effort limit on eval_bridge.
+    # enough. Held out 6-10 cm within a 0.6-0.8 s phase, the swing leg took the stance ankle
+    # or hip roll to 1.07-1.08 x its effort limit on eval_bridge; at 2 m/s^2 the plans that
+    # need it peak at 0.76-0.77 x (docs/results/2026-12-06-motion-held-bulge).
     bulge_acceleration: float = 2.0
     # Single support where the swing sole cannot reach its contact from the one-foot
     # posture's root (the plan stretches its legs to within a millimetre of their reach,

@@ -115,11 +115,11 @@ UPPER_BODY = 19
 # Bulges of a single support's swing path away from the stance sole, (m, held), tried in turn
 # where its configurations collide (`_single_support_coms`): a bump over the travel window
 # (a swing foot passing the stance shin on a stair: eval_stairs_0's landing 89 -> 90, cleared
-# by the 4 cm one), then a bulge held out while the legs pass (`paths.HELD_BULGES`: feet
-# 11 cm apart on eval_bridge, whose shins and knees a bump leaves in contact), its phase
-# lengthened for `MotionConfig.bulge_acceleration`. Held out as fast as a bump, the swing
+# by the 4 cm one), then a bulge held out while the legs pass (`paths.HELD_BULGES`: on
+# eval_bridge's beam a bump leaves the shins and knees in contact), its phase lengthened for
+# `MotionConfig.bulge_acceleration`. Held out within the phase's own duration, the swing
 # leg's sideways swing took the stance ankle or hip roll to 1.07-1.08 x its effort limit
-# (docs/results/2026-12-06-motion-clearance).
+# (docs/results/2026-12-06-motion-clearance; slowed: docs/results/2026-12-06-motion-held-bulge).
 SWING_BULGES = ((0.04, False), (0.08, False), (0.04, True), (0.07, True), (0.10, True))
 # The arms change between key postures over this fraction of a shift, at its start or end
 # (`upper_body_window`), the shift lengthened where their joints' speed needs it.

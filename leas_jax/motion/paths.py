@@ -42,7 +42,7 @@ LAND_WINDOWS = ((0.0, 0.7), (0.35, 0.85), (0.6, 1.0))
 
 
 # Spans (out, back) of normalised time of a held bulge (`swing_path`): where a swing foot
-# passes the stance leg close by (feet 11 cm apart on eval_bridge), a bump over the travel
+# passes the stance leg close by (eval_bridge's beam), a bump over the travel
 # window comes back while the swing shin is still beside the stance shin; a held bulge is out
 # before the knees pass and back once the sole is over its contact. A lift moves out while
 # its sole rises its first centimetres and comes back once high; a landing stays out until

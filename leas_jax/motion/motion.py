@@ -1333,8 +1333,7 @@ def swing_feet(spec: _PhaseSpec, fractions: np.ndarray) -> np.ndarray:
 
     The swing sole follows `paths.swing_path` below spec.apex (LIFT_WINDOWS or
     LAND_WINDOWS), bulging spec.swing_offset away from the stance sole (held out where
-    spec.swing_held), and turns while it
-    travels; at fraction 1 it is exactly at spec.feet1.
+    spec.swing_held), and turns while it travels; at fraction 1 it is exactly at spec.feet1.
     """
     from leas_jax.motion.paths import HELD_BULGES, LAND_WINDOWS, LIFT_WINDOWS, slerp, swing_path
 

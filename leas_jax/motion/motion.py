@@ -1139,7 +1139,7 @@ def _single_support(
         )
         if samples <= spec.samples:
             break
-        spec = dataclasses.replace(spec, samples=samples, swing_offset=0.0, swing_held=False)
+        spec = dataclasses.replace(spec, samples=samples)  # its bulges tried again from none
         spec, coms, configurations, profiled = _single_support_coms(
             talos, spec, k, config, balanced, clearance
         )
@@ -1228,12 +1228,14 @@ def _single_support_coms(
 def bulge_samples(kind: str, offset: float, config: MotionConfig) -> int:
     """Samples of a lift or land whose swing sole's held bulge of `offset` m
     (`paths.HELD_BULGES`) goes out and back with a peak sideways acceleration of at most
-    `config.bulge_acceleration`, m/s^2 (a minimum-jerk move over the shorter of its spans)."""
-    from leas_jax.motion.paths import HELD_BULGES, MIN_JERK_PEAK_ACCELERATION
+    `config.bulge_acceleration`, m/s^2: its shorter span is a minimum-jerk move of `offset`
+    (`paths.shift_duration`, on steps of that span's share of a sample)."""
+    from leas_jax.motion.paths import HELD_BULGES, shift_duration
 
     span = min(t1 - t0 for t0, t1 in HELD_BULGES[kind])
-    seconds = math.sqrt(MIN_JERK_PEAK_ACCELERATION * offset / config.bulge_acceleration) / span
-    return math.ceil(seconds / config.dt - 1e-9)
+    return round(
+        shift_duration(offset, config.bulge_acceleration, 0.0, span * config.dt) / (span * config.dt)
+    )
 
 
 def upper_body_window(clearance, q_a: np.ndarray, q_b: np.ndarray) -> tuple[float, float] | None:

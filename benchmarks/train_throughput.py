@@ -1,7 +1,8 @@
 """Geometric PPO throughput (env steps per second, learning included).
 
-For each preset and termination condition (`--conditions`: the presets' cylinders,
-the learned network of `EnvConfig(condition="learned")`), each judge of the clearance
+For each preset and termination condition (`--conditions`: "cylinders", the preset's own
+condition, which is the cylinders except for `generalist`'s walkability model; "learned", the
+arena-fitted network of `EnvConfig(condition="learned")`), each judge of the clearance
 term's probe poses (`--clearance-conditions`, learned condition only: the network itself or
 the cylinders, `EnvConfig.clearance_condition`), and optional overrides, compiles one
 training call, then times `--calls` calls. The bare reference env
@@ -75,14 +76,15 @@ def measure(config, field, calls: int) -> dict:
 
 def variants(name: str, conditions: list[str], judges: list[str], epochs: list[int]):
     """(label, [TrainConfig]) per condition and clearance-probe judge of preset `name`: the
-    preset's config, then one per `epochs` value. The judges apply to the learned condition
+    preset's config, then one per `epochs` value. "cylinders" keeps the preset's own condition
+    and is labelled with it. The judges apply to the learned condition
     where the preset has a clearance term (elsewhere the probes are not evaluated)."""
     from leas_jax.training.config import learned_condition_env, preset
 
     for condition in conditions:
         base = [preset(name)] + [preset(name, num_epochs=e) for e in epochs]
         if condition == "cylinders":
-            yield condition, base
+            yield base[0].env.condition, base
             continue
         probed = base[0].env.rewards.clearance != 0.0
         for judge in judges if probed else [judges[0]]:
@@ -102,7 +104,9 @@ def main() -> None:
     parser.add_argument("--presets", default="quick,paper")
     parser.add_argument("--calls", type=int, default=5)
     parser.add_argument("--epochs", default="", help="also measure these num_epochs values, e.g. 10,4")
-    parser.add_argument("--conditions", default="cylinders", help="comma-separated: cylinders, learned")
+    parser.add_argument(
+        "--conditions", default="cylinders", help="comma-separated: cylinders (the preset's own), learned"
+    )
     parser.add_argument(
         "--clearance-conditions",
         default="condition",

@@ -45,6 +45,7 @@ FIRST_X = (5.0, 6.0)  # m, the pillar on the line
 ON_LINE = 0.25  # m, |y - 4| of a pillar standing in the way
 IN_THE_WAY = 2  # pillars within ON_LINE of the line, at least
 MIN_GAP = 1.0  # m, between two pillars' circumscribed circles
+SQUARE = ((-1, -1), (1, -1), (1, 1), (-1, 1))  # a pillar's corners in half-sides, its own frame
 
 
 def pillar_boxes(seed: int):
@@ -154,9 +155,8 @@ def plot_fields(seeds: list[int], path: Path) -> None:
     figure, axes = plt.subplots(rows, columns, figsize=(2.6 * columns, 1.9 * rows), layout="constrained")
     for ax, seed in zip(np.atleast_1d(axes).ravel(), seeds, strict=False):
         for x, y, side, yaw in pillar_boxes(seed):
-            c, s = math.cos(yaw), math.sin(yaw)
-            corners = [(x + c * u - s * v, y + s * u + c * v) for u, v in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-            corners = [(x + (cx - x) * side / 2, y + (cy - y) * side / 2) for cx, cy in corners]
+            c, s, h = math.cos(yaw), math.sin(yaw), side / 2
+            corners = [(x + h * (c * u - s * v), y + h * (s * u + c * v)) for u, v in SQUARE]
             ax.add_patch(Polygon(corners, color="0.3"))
         ax.plot(*START, "go", ms=4)
         ax.plot(*TARGET, "r*", ms=7)

@@ -91,13 +91,13 @@ def pillar_field(seed: int, starts: int) -> str:
     )
 
 
-def field_row(checkpoint: str, terrain: Path, workers: int) -> dict:
+def field_row(checkpoint: str, terrain: Path, workers: int, method: str = "leas") -> dict:
     from leas_jax.eval.evaluate import evaluate
 
     began = time.perf_counter()
     report = evaluate(
         [],
-        methods=["leas"],
+        methods=[method],
         checkpoint=checkpoint,
         out=None,
         workers=workers,
@@ -189,6 +189,9 @@ def main() -> None:
     parser.add_argument("--fields", type=int, default=20, help="fields, seeds 0 to N - 1")
     parser.add_argument("--starts", type=int, default=10, help="starts per field")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument(
+        "--method", choices=("leas", "navigate"), default="leas", help="what the policies steer"
+    )
     args = parser.parse_args()
     out = Path(args.out)
     (out / "fields").mkdir(parents=True, exist_ok=True)
@@ -207,7 +210,7 @@ def main() -> None:
         for seed in seeds:
             if str(seed) in rows:
                 continue
-            rows[str(seed)] = field_row(checkpoint, files[seed], args.workers)
+            rows[str(seed)] = field_row(checkpoint, files[seed], args.workers, args.method)
             r = rows[str(seed)]
             print(f"{label} field {seed}: {r['success']}/{r['n']} ({r['seconds']} s)", flush=True)
             results["machine"] = _machine()

@@ -119,7 +119,8 @@ def scenario_row(checkpoint: str, terrain: str, n_starts: int, workers: int) -> 
     }
 
 
-def _ci(k: int, n: int) -> str:
+def percent_with_interval(k: int, n: int) -> str:
+    """'p [lo, hi]': k of n in percent with its Wilson 95 % interval."""
     low, high = wilson(k, n)
     return f"{100 * k / n:.1f} [{100 * low:.1f}, {100 * high:.1f}]"
 
@@ -138,7 +139,7 @@ def markdown(results: dict) -> str:
                 continue
             k, n = sum(r["fully_covered"] for r in rows), sum(r["guides"] for r in rows)
             progress = np.mean([r["mean_progress_m"] for r in rows])
-            cells += [f"{_ci(k, n)} (n {n})", f"{progress:.2f}"]
+            cells += [f"{percent_with_interval(k, n)} (n {n})", f"{progress:.2f}"]
         lines.append(f"| {arena} | " + " | ".join(cells) + " |")
     lines += ["", "## Scenarios: LeaS success % [95 % CI] (coverage %)", ""]
     lines.append("| scenario | " + " | ".join(policies) + " |")
@@ -147,7 +148,11 @@ def markdown(results: dict) -> str:
         cells = []
         for p in policies:
             r = results["scenarios"].get(p, {}).get(scenario)
-            cells.append("" if r is None else f"{_ci(r['success'], r['n'])} ({100 * r['mean_coverage']:.0f})")
+            cells.append(
+                ""
+                if r is None
+                else f"{percent_with_interval(r['success'], r['n'])} ({100 * r['mean_coverage']:.0f})"
+            )
         lines.append(f"| {Path(scenario).stem} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -195,7 +200,8 @@ def plot_training(run_dir: Path, path: Path) -> None:
     plot_curves(read_metrics(run_dir), TRAINING_PANELS, path)
 
 
-def _machine() -> dict:
+def machine() -> dict:
+    """The machine, its load and the repository's commit, recorded with a study's results."""
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
     return {
         "machine": platform.processor() or platform.machine(),
@@ -229,7 +235,7 @@ def main() -> None:
     )
 
     def save():
-        results["machine"] = _machine()
+        results["machine"] = machine()
         tmp = store.with_suffix(".tmp")
         tmp.write_text(json.dumps(results, indent=1) + "\n")
         tmp.replace(store)

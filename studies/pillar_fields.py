@@ -22,17 +22,15 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
-import subprocess
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from leas_jax.stats import wilson
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from generalist import machine, percent_with_interval  # noqa: E402 (the curriculum study's table helpers)
 
-ROOT = Path(__file__).resolve().parents[1]
 BOUNDS = ((0.0, 0.0), (12.0, 8.0))
 START = (4.0, 4.0)
 TARGET = (10.5, 4.0)
@@ -114,11 +112,6 @@ def field_row(checkpoint: str, terrain: Path, workers: int, method: str = "leas"
     }
 
 
-def _ci(k: int, n: int) -> str:
-    low, high = wilson(k, n)
-    return f"{100 * k / n:.1f} [{100 * low:.1f}, {100 * high:.1f}]"
-
-
 def markdown(results: dict) -> str:
     policies = list(results["policies"])
     lines = ["| policy | starts | success % [95 % CI] | fields with every start reached | mean coverage % |"]
@@ -130,7 +123,9 @@ def markdown(results: dict) -> str:
         k, n = sum(r["success"] for r in rows), sum(r["n"] for r in rows)
         whole = sum(r["success"] == r["n"] for r in rows)
         coverage = 100 * np.mean([r["mean_coverage"] for r in rows])
-        lines.append(f"| {p} | {n} | {_ci(k, n)} | {whole} / {len(rows)} | {coverage:.1f} |")
+        lines.append(
+            f"| {p} | {n} | {percent_with_interval(k, n)} | {whole} / {len(rows)} | {coverage:.1f} |"
+        )
     lines += ["", "Per field (successes of the starts):", ""]
     seeds = sorted({int(s) for rows in results["results"].values() for s in rows})
     lines.append("| policy | " + " | ".join(str(s) for s in seeds) + " |")
@@ -172,16 +167,6 @@ def plot_fields(seeds: list[int], path: Path) -> None:
     plt.close(figure)
 
 
-def _machine() -> dict:
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
-    return {
-        "machine": platform.processor() or platform.machine(),
-        "cpus": os.cpu_count(),
-        "load": os.getloadavg()[0],
-        "commit": commit.stdout.strip(),
-    }
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--policy", action="append", required=True, metavar="LABEL=RUN_DIR")
@@ -213,7 +198,7 @@ def main() -> None:
             rows[str(seed)] = field_row(checkpoint, files[seed], args.workers, args.method)
             r = rows[str(seed)]
             print(f"{label} field {seed}: {r['success']}/{r['n']} ({r['seconds']} s)", flush=True)
-            results["machine"] = _machine()
+            results["machine"] = machine()
             tmp = path.with_suffix(".tmp")
             tmp.write_text(json.dumps(results, indent=1))
             tmp.replace(path)

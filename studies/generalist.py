@@ -97,12 +97,16 @@ def arena_row(policy, terrain_path: Path, seed: int, episodes: int, guides: int,
     }
 
 
-def scenario_row(checkpoint: str, terrain: str, n_starts: int, workers: int) -> dict:
+def scenario_row(
+    checkpoint: str, terrain: str, n_starts: int | None, workers: int, method: str = "leas"
+) -> dict:
+    """Success and coverage of `leas evaluate --methods METHOD` on a terrain file with a
+    [scenario] (relative to the repository or absolute; n_starts None: the table's)."""
     from leas_jax.eval.evaluate import evaluate
 
     report = evaluate(
         [],
-        methods=["leas"],
+        methods=[method],
         checkpoint=checkpoint,
         out=None,
         n_starts=n_starts,

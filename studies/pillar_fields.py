@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from generalist import machine, percent_with_interval  # noqa: E402 (the curriculum study's table helpers)
+from generalist import machine, percent_with_interval, scenario_row  # noqa: E402 (the curriculum study's)
 
 BOUNDS = ((0.0, 0.0), (12.0, 8.0))
 START = (4.0, 4.0)
@@ -90,26 +90,10 @@ def pillar_field(seed: int, starts: int) -> str:
 
 
 def field_row(checkpoint: str, terrain: Path, workers: int, method: str = "leas") -> dict:
-    from leas_jax.eval.evaluate import evaluate
-
+    """`scenario_row` of one field, with the seconds it took."""
     began = time.perf_counter()
-    report = evaluate(
-        [],
-        methods=[method],
-        checkpoint=checkpoint,
-        out=None,
-        workers=workers,
-        terrain_file=str(terrain),
-        progress=False,
-        figures=False,
-    )
-    runs = [t for scenario in report["scenarios"].values() for t in scenario["trajectories"]]
-    return {
-        "n": len(runs),
-        "success": sum(bool(t["success"]) for t in runs),
-        "mean_coverage": float(np.mean([t["coverage"] for t in runs])),
-        "seconds": round(time.perf_counter() - began, 1),
-    }
+    row = scenario_row(checkpoint, str(terrain.resolve()), None, workers, method)
+    return {**row, "seconds": round(time.perf_counter() - began, 1)}
 
 
 def markdown(results: dict) -> str:

@@ -255,7 +255,7 @@ QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.
 # terrain families, envs moved between rows as legged_gym's terrain levels move them,
 # `EnvConfig.curriculum`), terminating on the walkability model of rough ground (fitted on the
 # same families: `leas feasibility walkability`) instead of the arena-fitted condition. The
-# reward terms are `quick`'s. Measured (docs/results/2026-12-07-generalist-recipe, one or two
+# reward terms are `quick`'s. Measured (docs/results/2026-12-07-generalist-recipe, one to three
 # seeds each): without the clearance term, or with the `paper` preset's 10 epochs as well, a policy
 # walks at most 0.5 m further per episode and still stops at stairs; what stops it is the
 # walkability model, which ends an episode on every stair flight the generator climbs, at poses

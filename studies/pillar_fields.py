@@ -5,7 +5,7 @@ straight line from the start to a target 6.5 m ahead. This study draws a family 
 seeds: flat 12 x 8 m ground, the same start region and target, 3 to 6 square pillars 0.25-0.40
 m wide and 1.5 m high at random turns, between 1 and 5.5 m ahead of the start region, the first
 on the start-target line and at least two within 0.25 m of it, every two at least 1.0 m apart
-face to face (Talos passes the check's 1.1 m gate; `pillar_field`). Each policy runs `leas
+face to face (Talos passes the check's 1.1 m gate; `pillar_boxes`). Each policy runs `leas
 evaluate --methods leas` on each field (`--starts` seeded starts, yaw +-30 deg): success is
 the contact plan covering the whole guide and ending within 0.30 m of the target.
 
@@ -40,6 +40,7 @@ PILLAR_HEIGHT = 1.5  # m
 PILLAR_X = (5.0, 9.5)  # m, 1 to 5.5 m ahead of the start region's centre
 PILLAR_Y = (2.6, 5.4)  # m, up to 1.4 m beside the line
 FIRST_X = (5.0, 6.0)  # m, the pillar on the line
+FIRST_Y = 0.1  # m, |y - 4| of the pillar on the line, at most
 ON_LINE = 0.25  # m, |y - 4| of a pillar standing in the way
 IN_THE_WAY = 2  # pillars within ON_LINE of the line, at least
 MIN_GAP = 1.0  # m, between two pillars' circumscribed circles
@@ -51,7 +52,8 @@ def pillar_boxes(seed: int):
     rng = np.random.default_rng(seed)
     while True:
         count = int(rng.integers(PILLAR_COUNT[0], PILLAR_COUNT[1] + 1))
-        pillars = [(rng.uniform(*FIRST_X), 4.0 + rng.uniform(-0.1, 0.1), rng.uniform(*PILLAR_SIDE))]
+        line = START[1]
+        pillars = [(rng.uniform(*FIRST_X), line + rng.uniform(-FIRST_Y, FIRST_Y), rng.uniform(*PILLAR_SIDE))]
         for _ in range(200 * count):
             if len(pillars) == count:
                 break
@@ -60,7 +62,7 @@ def pillar_boxes(seed: int):
                 math.hypot(x - px, y - py) - (side + ps) / math.sqrt(2) >= MIN_GAP for px, py, ps in pillars
             ):
                 pillars.append((x, y, side))
-        if len(pillars) == count and sum(abs(y - 4.0) < ON_LINE for _, y, _ in pillars) >= IN_THE_WAY:
+        if len(pillars) == count and sum(abs(y - line) < ON_LINE for _, y, _ in pillars) >= IN_THE_WAY:
             return [(x, y, side, float(rng.uniform(0.0, math.pi / 2))) for x, y, side in pillars]
 
 

@@ -174,3 +174,43 @@ def test_walkability_command_errors_are_one_line(args, message, tmp_path):
     assert run.returncode == 2
     lines = [line for line in run.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and re.search(message, lines[0]), run.stderr
+
+
+def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
+    """`test_poses_per_terrain` sets the draws of the test terrains and scenes, the fit keeps
+    `poses_per_terrain`, and a test pose is the same pose whatever the fit's draws: a build with
+    many small fitting terrains is judged on the same poses as one with a few large ones."""
+    drawn = []
+
+    def labels(terrain, poses, cache, workers, generator_config=None):
+        drawn.append((terrain.name, len(poses), poses[:3].copy()))
+        return poses[:, 0] < 3.5  # a known rule, so that both classes are there to fit
+
+    monkeypatch.setattr(wk, "walking_labels", labels)
+    scene = loads_terrain(family_terrain("slopes", 7), source="<scene>")
+    config = dataclasses.replace(
+        CONFIG,
+        train_families=("gaps", "slopes"),
+        held_out_families=("stones",),
+        terrains_per_family=3,
+        test_terrains_per_family=1,
+        poses_per_terrain=20,
+        test_poses_per_terrain=60,
+    )
+    wk.build(tmp_path / "w.npz", config, scenes=(scene,), cache=tmp_path, workers=0, say=lambda _: None)
+    counts = [n for _, n, _ in drawn]
+    fit_draws, test_draws = counts[:6], counts[6:]
+    assert len(test_draws) == 4  # gaps, slopes, stones on seed 100, and the scene
+    assert max(fit_draws) <= 20 < min(test_draws) <= 60
+    first_test = drawn[6][2]
+    drawn.clear()
+    wk.build(
+        tmp_path / "v.npz",
+        dataclasses.replace(config, terrains_per_family=1, poses_per_terrain=60),
+        scenes=(scene,),
+        cache=tmp_path,
+        workers=0,
+        say=lambda _: None,
+    )
+    assert np.array_equal(drawn[2][2], first_test), "a test terrain's poses do not depend on the fit's"
+    assert wk.draws_per_test_terrain(dataclasses.replace(config, test_poses_per_terrain=None)) == 20

@@ -91,6 +91,7 @@ def cmd_walkability(args) -> int:
         terrains_per_family=args.terrains_per_family,
         test_terrains_per_family=args.test_terrains_per_family,
         poses_per_terrain=args.poses_per_terrain,
+        test_poses_per_terrain=args.test_poses_per_terrain,
     )
     scenes = _scenes(args.scenes or [])
     report = build(out, config, scenes, cache=Path(args.cache), workers=args.workers)
@@ -228,7 +229,16 @@ def _register_walkability(targets) -> None:
         help="test terrains per family (default 3)",
     )
     parser.add_argument(
-        "--poses-per-terrain", type=positive_int, default=300, help="pose draws (default 300)"
+        "--poses-per-terrain",
+        type=positive_int,
+        default=300,
+        help="pose draws per fitting terrain (default 300)",
+    )
+    parser.add_argument(
+        "--test-poses-per-terrain",
+        type=positive_int,
+        default=None,
+        help="pose draws per test terrain and scene (default: --poses-per-terrain)",
     )
     parser.add_argument(
         "--scenes", nargs="*", metavar="GLOB", help="terrain files whose poses test the model too"

@@ -57,7 +57,11 @@ class WalkabilityConfig:
     held_out_families: tuple = HELD_OUT
     terrains_per_family: int = 6  # seeds 0..n-1 fit (training families); seeds 100.. test
     test_terrains_per_family: int = 3
-    poses_per_terrain: int = 300  # plausible poses drawn per terrain (before labelling)
+    poses_per_terrain: int = 300  # plausible poses drawn per fitting terrain (before labelling)
+    # draws per test terrain and scene (None: poses_per_terrain). The fit gains more from many
+    # terrains with few poses each (each stair flight is one riser and tread) than from many
+    # poses on few terrains, while a test keeps its poses: same seeds, same draws.
+    test_poses_per_terrain: int | None = None
     feature_fraction: float = 0.8  # share of poses drawn over the feature's x band (+-0.5 m)
     target_sensitivity: float = 0.95  # the threshold keeps this share of walkable poses
     nominal_root_height: float = 1.0  # m above the ground (EnvConfig.nominal_root_height)
@@ -320,8 +324,9 @@ def rates(predicted: np.ndarray, y: np.ndarray) -> dict:
     }
 
 
-def family_sets(families, seeds, config, cache, workers, grid_params, say) -> list[LabelledSet]:
-    """A `LabelledSet` per (family, seed) terrain."""
+def family_sets(families, seeds, config, cache, workers, grid_params, say, count=None) -> list[LabelledSet]:
+    """A `LabelledSet` per (family, seed) terrain, `count` pose draws each (None:
+    `config.poses_per_terrain`)."""
     from leas_jax.terrain import loads_terrain
 
     out = []
@@ -332,7 +337,7 @@ def family_sets(families, seeds, config, cache, workers, grid_params, say) -> li
             part = labelled_terrain(
                 terrain,
                 family,
-                config.poses_per_terrain,
+                config.poses_per_terrain if count is None else count,
                 config.seed + seed,
                 config,
                 cache,
@@ -348,6 +353,13 @@ def family_sets(families, seeds, config, cache, workers, grid_params, say) -> li
 
 
 # ---- fit and report ----------------------------------------------------------------------------
+
+
+def draws_per_test_terrain(config: WalkabilityConfig) -> int:
+    """Pose draws per test terrain and per scene."""
+    return (
+        config.poses_per_terrain if config.test_poses_per_terrain is None else config.test_poses_per_terrain
+    )
 
 
 def data_key(config: WalkabilityConfig, scenes=()) -> str:
@@ -440,18 +452,21 @@ def build(
     train = concatenate(
         family_sets(config.train_families, fit_seeds, config, cache, workers, grid_params, say)
     )
+    test_count = draws_per_test_terrain(config)
     seen = concatenate(
-        family_sets(config.train_families, test_seeds, config, cache, workers, grid_params, say)
+        family_sets(config.train_families, test_seeds, config, cache, workers, grid_params, say, test_count)
     )
     held = concatenate(
-        family_sets(config.held_out_families, test_seeds, config, cache, workers, grid_params, say)
+        family_sets(
+            config.held_out_families, test_seeds, config, cache, workers, grid_params, say, test_count
+        )
     )
     scene_sets = []
     for k, scene in enumerate(scenes):
         part = labelled_terrain(
             scene,
             scene.name,
-            config.poses_per_terrain,
+            test_count,
             config.seed + 1000 + k,
             config,
             cache,

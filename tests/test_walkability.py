@@ -214,3 +214,14 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
     )
     assert np.array_equal(drawn[2][2], first_test), "a test terrain's poses do not depend on the fit's"
     assert wk.draws_per_test_terrain(dataclasses.replace(config, test_poses_per_terrain=None)) == 20
+
+
+def test_the_default_build_is_the_shipped_models_recipe():
+    """`leas feasibility walkability` with no size options rebuilds the shipped model: its recorded
+    settings are the config's defaults."""
+    import json
+    from pathlib import Path
+
+    shipped = json.loads((Path(__file__).parents[1] / "checkpoints/walkability/walkability.json").read_text())
+    defaults = json.loads(json.dumps(dataclasses.asdict(wk.WalkabilityConfig())))
+    assert shipped["config"] == defaults

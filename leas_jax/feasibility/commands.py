@@ -84,14 +84,21 @@ def cmd_walkability(args) -> int:
     unknown = [f for f in held if f not in FAMILIES]
     if unknown:
         raise UsageError(f"--held-out: unknown families {', '.join(unknown)} (known: {', '.join(FAMILIES)})")
+    sizes = {
+        name: getattr(args, name)
+        for name in (
+            "terrains_per_family",
+            "test_terrains_per_family",
+            "poses_per_terrain",
+            "test_poses_per_terrain",
+        )
+        if getattr(args, name) is not None
+    }
     config = dataclasses.replace(
         WalkabilityConfig(),
         train_families=tuple(f for f in FAMILIES if f not in held),
         held_out_families=held,
-        terrains_per_family=args.terrains_per_family,
-        test_terrains_per_family=args.test_terrains_per_family,
-        poses_per_terrain=args.poses_per_terrain,
-        test_poses_per_terrain=args.test_poses_per_terrain,
+        **sizes,
     )
     scenes = _scenes(args.scenes or [])
     report = build(out, config, scenes, cache=Path(args.cache), workers=args.workers)
@@ -220,25 +227,28 @@ def _register_walkability(targets) -> None:
         help="families kept out of the fit, comma-separated (default: the shipped model's)",
     )
     parser.add_argument(
-        "--terrains-per-family", type=positive_int, default=6, help="fitting terrains (default 6)"
+        "--terrains-per-family",
+        type=positive_int,
+        default=None,
+        help="fitting terrains per training family (default: the shipped model's, 120)",
     )
     parser.add_argument(
         "--test-terrains-per-family",
         type=positive_int,
-        default=3,
-        help="test terrains per family (default 3)",
+        default=None,
+        help="test terrains per family (default 2)",
     )
     parser.add_argument(
         "--poses-per-terrain",
         type=positive_int,
-        default=300,
-        help="pose draws per fitting terrain (default 300)",
+        default=None,
+        help="pose draws per fitting terrain (default 25)",
     )
     parser.add_argument(
         "--test-poses-per-terrain",
         type=positive_int,
         default=None,
-        help="pose draws per test terrain and scene (default: --poses-per-terrain)",
+        help="pose draws per test terrain and scene (default 250)",
     )
     parser.add_argument(
         "--scenes", nargs="*", metavar="GLOB", help="terrain files whose poses test the model too"

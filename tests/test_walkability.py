@@ -177,9 +177,10 @@ def test_walkability_command_errors_are_one_line(args, message, tmp_path):
 
 
 def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
-    """`test_poses_per_terrain` sets the draws of the test terrains and scenes, the fit keeps
-    `poses_per_terrain`, and a test pose is the same pose whatever the fit's draws: a build with
-    many small fitting terrains is judged on the same poses as one with a few large ones."""
+    """`test_poses_per_terrain` sets the draws of the test terrains and scenes, the held-out
+    families have terrains and draws of their own, the fit keeps `poses_per_terrain`, and a test
+    pose is the same pose whatever the fit's draws: a build with many small fitting terrains is
+    judged on the same poses as one with a few large ones."""
     drawn = []
 
     def labels(terrain, poses, cache, workers, generator_config=None):
@@ -191,17 +192,19 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
     config = dataclasses.replace(
         CONFIG,
         train_families=("gaps", "slopes"),
-        held_out_families=("stones",),
+        held_out_families=("blocks",),
         terrains_per_family=3,
         test_terrains_per_family=1,
         poses_per_terrain=20,
         test_poses_per_terrain=60,
+        held_out_terrains_per_family=2,
+        held_out_poses_per_terrain=40,
     )
     wk.build(tmp_path / "w.npz", config, scenes=(scene,), cache=tmp_path, workers=0, say=lambda _: None)
     counts = [n for _, n, _ in drawn]
-    fit_draws, test_draws = counts[:6], counts[6:]
-    assert len(test_draws) == 4  # gaps, slopes, stones on seed 100, and the scene
-    assert max(fit_draws) <= 20 < min(test_draws) <= 60
+    fit_draws, test_draws, held_draws, scene_draws = counts[:6], counts[6:8], counts[8:10], counts[10:]
+    assert len(scene_draws) == 1  # gaps and slopes on seed 100, blocks on seeds 200 and 201, the scene
+    assert max(fit_draws) <= 20 < max(held_draws) <= 40 < min(test_draws + scene_draws) <= 60
     first_test = drawn[6][2]
     drawn.clear()
     wk.build(

@@ -91,6 +91,8 @@ def cmd_walkability(args) -> int:
             "test_terrains_per_family",
             "poses_per_terrain",
             "test_poses_per_terrain",
+            "held_out_terrains_per_family",
+            "held_out_poses_per_terrain",
         )
         if getattr(args, name) is not None
     }
@@ -249,6 +251,18 @@ def _register_walkability(targets) -> None:
         type=positive_int,
         default=None,
         help="pose draws per test terrain and scene (default 250)",
+    )
+    parser.add_argument(
+        "--held-out-terrains-per-family",
+        type=positive_int,
+        default=None,
+        help="terrains of each held-out family, seeds 200.. (default 30)",
+    )
+    parser.add_argument(
+        "--held-out-poses-per-terrain",
+        type=positive_int,
+        default=None,
+        help="pose draws per held-out terrain (default 50)",
     )
     parser.add_argument(
         "--scenes", nargs="*", metavar="GLOB", help="terrain files whose poses test the model too"

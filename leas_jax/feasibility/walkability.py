@@ -332,29 +332,36 @@ def rates(predicted: np.ndarray, y: np.ndarray) -> dict:
 
 def family_sets(families, seeds, config, cache, workers, grid_params, say, count=None) -> list[LabelledSet]:
     """A `LabelledSet` per (family, seed) terrain, `count` pose draws each (None:
-    `config.poses_per_terrain`)."""
+    `config.poses_per_terrain`). A progress bar per family where stderr is a terminal, and one
+    line per family through `say`."""
+    from tqdm.auto import tqdm
+
     from leas_jax.terrain import loads_terrain
 
     out = []
     for family in families:
-        for seed in seeds:
-            began = time.perf_counter()
+        began = time.perf_counter()
+        parts = []
+        for seed in tqdm(seeds, desc=f"{family}: labelling", unit="terrain", leave=False, disable=None):
             terrain = loads_terrain(family_terrain(family, seed), source=f"<family {family} {seed}>")
-            part = labelled_terrain(
-                terrain,
-                family,
-                config.poses_per_terrain if count is None else count,
-                config.seed + seed,
-                config,
-                cache,
-                workers,
-                grid_params,
+            parts.append(
+                labelled_terrain(
+                    terrain,
+                    family,
+                    config.poses_per_terrain if count is None else count,
+                    config.seed + seed,
+                    config,
+                    cache,
+                    workers,
+                    grid_params,
+                )
             )
-            say(
-                f"{family} seed {seed}: {len(part.y)} plausible poses, {int(part.y.sum())} walkable "
-                f"({time.perf_counter() - began:.1f} s)"
-            )
-            out.append(part)
+        poses, walkable = sum(len(p.y) for p in parts), sum(int(p.y.sum()) for p in parts)
+        say(
+            f"{family}, {len(parts)} terrains (seeds {seeds[0]}-{seeds[-1]}): {poses} plausible poses, "
+            f"{walkable} walkable ({time.perf_counter() - began:.1f} s)"
+        )
+        out += parts
     return out
 
 

@@ -216,7 +216,6 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
         say=lambda _: None,
     )
     assert np.array_equal(drawn[2][2], first_test), "a test terrain's poses do not depend on the fit's"
-    assert wk.draws_per_test_terrain(dataclasses.replace(config, test_poses_per_terrain=None)) == 20
 
 
 def test_the_default_build_is_the_shipped_models_recipe():

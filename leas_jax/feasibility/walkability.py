@@ -55,15 +55,15 @@ class WalkabilityConfig:
 
     train_families: tuple = tuple(f for f in FAMILIES if f not in HELD_OUT)
     held_out_families: tuple = HELD_OUT
-    # 120 terrains x 25 draws of each training family fit; 2 unseen terrains x 250 draws of every
-    # family and 250 draws per scene test. Many small fitting terrains rather than a few large
+    # 120 terrains x 25 draws of each training family fit; 2 unseen terrains x 250 draws of each
+    # training family and 250 draws per scene test. Many small fitting terrains rather than a few large
     # ones (each stair flight is one riser and tread): at the same label cost, 40 x 25 against
     # 4 x 250 refused 78.0 % of the unwalkable poses of unseen terrains against 72.3 %, and 80 or
     # 120 x 25 80.3 %, at 94-95 % sensitivity (docs/results/2026-12-07-walkability-many-terrains).
     terrains_per_family: int = 120  # seeds 0..n-1 fit (training families); seeds 100.. test
     test_terrains_per_family: int = 2
     poses_per_terrain: int = 25  # plausible poses drawn per fitting terrain (before labelling)
-    test_poses_per_terrain: int | None = 250  # per test terrain and scene (None: poses_per_terrain)
+    test_poses_per_terrain: int = 250  # pose draws per test terrain and per scene (before labelling)
     # The held-out families are judged on terrains of their own, many of them: on two terrains
     # (seeds 100-101) the blocks held 5 unwalkable poses of 499, on 30 (seeds 200-229) 536 of 1481.
     held_out_terrains_per_family: int = 30  # seeds 200..
@@ -368,13 +368,6 @@ def family_sets(families, seeds, config, cache, workers, grid_params, say, count
 # ---- fit and report ----------------------------------------------------------------------------
 
 
-def draws_per_test_terrain(config: WalkabilityConfig) -> int:
-    """Pose draws per test terrain and per scene."""
-    return (
-        config.poses_per_terrain if config.test_poses_per_terrain is None else config.test_poses_per_terrain
-    )
-
-
 def build_seeds(config: WalkabilityConfig) -> tuple[range, range, range]:
     """Terrain seeds of a build: (fit and test seeds of the training families, seeds of the
     held-out families)."""
@@ -473,9 +466,17 @@ def build(
     train = concatenate(
         family_sets(config.train_families, fit_seeds, config, cache, workers, grid_params, say)
     )
-    test_count = draws_per_test_terrain(config)
     seen = concatenate(
-        family_sets(config.train_families, test_seeds, config, cache, workers, grid_params, say, test_count)
+        family_sets(
+            config.train_families,
+            test_seeds,
+            config,
+            cache,
+            workers,
+            grid_params,
+            say,
+            config.test_poses_per_terrain,
+        )
     )
     held = concatenate(
         family_sets(
@@ -494,7 +495,7 @@ def build(
         part = labelled_terrain(
             scene,
             scene.name,
-            test_count,
+            config.test_poses_per_terrain,
             config.seed + 1000 + k,
             config,
             cache,

@@ -49,15 +49,24 @@ def comma_floats(count: int, name: str):
     return parse
 
 
-def non_negative_seconds(text: str) -> float:
-    """argparse type: a finite number of seconds >= 0."""
+def _finite_non_negative(text: str, what: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds >= 0, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected {what} >= 0, got {text!r}") from None
     if not (value >= 0.0 and value != float("inf")):
-        raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a finite {what} >= 0, got {text!r}")
     return value
+
+
+def non_negative_seconds(text: str) -> float:
+    """argparse type: a finite number of seconds >= 0."""
+    return _finite_non_negative(text, "number of seconds")
+
+
+def non_negative_float(text: str) -> float:
+    """argparse type: a finite number >= 0."""
+    return _finite_non_negative(text, "number")
 
 
 def add_allow_pickle_argument(parser, what: str) -> None:

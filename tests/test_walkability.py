@@ -160,6 +160,8 @@ def test_a_model_labelled_by_another_generator_warns_when_loaded(tmp_path):
         (["--held-out", "lava"], "--held-out: unknown families lava"),
         (["--scenes", "no/such/*.toml"], "--scenes: 'no/such/\\*.toml' matches no file"),
         (["--poses-per-terrain", "0"], "--poses-per-terrain"),
+        (["--root-height-jitter", "-0.1"], "--root-height-jitter: expected a finite number >= 0"),
+        (["--terrains-per-family", "9990"], "--terrains-per-family, --jittered-terrains-per-family: at most"),
     ],
 )
 def test_walkability_command_errors_are_one_line(args, message, tmp_path):
@@ -194,6 +196,7 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
         train_families=("gaps", "slopes"),
         held_out_families=("blocks",),
         terrains_per_family=3,
+        jittered_terrains_per_family=1,
         test_terrains_per_family=1,
         poses_per_terrain=20,
         test_poses_per_terrain=60,
@@ -202,10 +205,12 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
     )
     wk.build(tmp_path / "w.npz", config, scenes=(scene,), cache=tmp_path, workers=0, say=lambda _: None)
     counts = [n for _, n, _ in drawn]
-    fit_draws, test_draws, held_draws, scene_draws = counts[:6], counts[6:8], counts[8:10], counts[10:]
-    assert len(scene_draws) == 1  # gaps and slopes on seed 100, blocks on seeds 200 and 201, the scene
+    # the fit (3 + 1 jittered terrains of gaps and slopes), the tests (one terrain of each, nominal
+    # and jittered), blocks on two terrains, the scene
+    assert len(counts) == 8 + 4 + 2 + 1
+    fit_draws, test_draws, held_draws, scene_draws = counts[:8], counts[8:12], counts[12:14], counts[14:]
     assert max(fit_draws) <= 20 < max(held_draws) <= 40 < min(test_draws + scene_draws) <= 60
-    first_test = drawn[6][2]
+    first_test = drawn[8][2]
     drawn.clear()
     wk.build(
         tmp_path / "v.npz",
@@ -215,7 +220,38 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
         workers=0,
         say=lambda _: None,
     )
-    assert np.array_equal(drawn[2][2], first_test), "a test terrain's poses do not depend on the fit's"
+    assert np.array_equal(drawn[4][2], first_test), "a test terrain's poses do not depend on the fit's"
+
+
+def test_no_fitting_terrain_is_a_test_terrain():
+    """The fit's seeds (nominal and jittered), the tests' and the held-out families' are apart for
+    any size up to the bound, and a size past it is refused."""
+    for terrains in (1, 120, wk.TEST_SEEDS - 40):
+        seeds = wk.build_seeds(dataclasses.replace(CONFIG, terrains_per_family=terrains))
+        training = [seeds.fit, seeds.jittered_fit, seeds.test, seeds.jittered_test]
+        every = [s for r in training for s in r]
+        assert len(every) == len(set(every)) == sum(len(r) for r in training)
+        assert len(seeds.fit) == terrains and len(seeds.held_out) == CONFIG.held_out_terrains_per_family
+    with pytest.raises(ValueError, match="at most 10000 fitting terrains"):
+        wk.build_seeds(dataclasses.replace(CONFIG, terrains_per_family=wk.TEST_SEEDS))
+
+
+def test_jittered_poses_are_the_lattices_poses_moved_up_or_down():
+    """Jittered root heights keep the lattice's (x, y, yaw) draws, move z by at most the jitter,
+    and every pose kept is plausible at its own height; without jitter the draws are unchanged."""
+    terrain, field = _field(family_terrain("stairs", 3))
+    nominal, nominal_cylinders = wk.plausible_poses(field, terrain.bounds, 300, 5, CONFIG)
+    again, _ = wk.plausible_poses(field, terrain.bounds, 300, 5, CONFIG, height_jitter=0.0)
+    assert np.array_equal(again, nominal)
+    jittered, cylinders = wk.plausible_poses(field, terrain.bounds, 300, 5, CONFIG, height_jitter=0.1)
+    index = {tuple(p[[0, 1, 3]]): p[2] for p in nominal}
+    moved = np.array([p[2] - index[tuple(p[[0, 1, 3]])] for p in jittered])  # KeyError: a new draw
+    assert np.abs(moved).max() <= 0.1 + 1e-6 and np.abs(moved).max() > 0.05
+    assert 0.5 * len(nominal) < len(jittered) <= len(nominal)
+    relaxed = wk.relaxed_reachability(ReachabilityConfig())
+    assert wk._valid_at(field, jittered, relaxed).all()
+    assert np.array_equal(cylinders, wk._valid_at(field, jittered, ReachabilityConfig()))
+    assert nominal_cylinders.any() and cylinders.any() and not cylinders.all()
 
 
 def test_the_default_build_is_the_shipped_models_recipe():

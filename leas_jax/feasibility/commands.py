@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from leas_jax.arguments import non_negative_int, positive_int
+from leas_jax.arguments import non_negative_float, non_negative_int, positive_int
 from leas_jax.errors import UsageError
 
 
@@ -74,7 +74,14 @@ def cmd_walkability(args) -> int:
     """Label, fit, write the weights and the report; print the report's table."""
     import dataclasses
 
-    from leas_jax.feasibility.walkability import HELD_OUT, WEIGHTS, WalkabilityConfig, build, report_table
+    from leas_jax.feasibility.walkability import (
+        HELD_OUT,
+        WEIGHTS,
+        WalkabilityConfig,
+        build,
+        build_seeds,
+        report_table,
+    )
     from leas_jax.terrain.families import FAMILIES
 
     out = Path(WEIGHTS if args.out is None else args.out)
@@ -93,6 +100,8 @@ def cmd_walkability(args) -> int:
             "test_poses_per_terrain",
             "held_out_terrains_per_family",
             "held_out_poses_per_terrain",
+            "jittered_terrains_per_family",
+            "root_height_jitter",
         )
         if getattr(args, name) is not None
     }
@@ -102,6 +111,10 @@ def cmd_walkability(args) -> int:
         held_out_families=held,
         **sizes,
     )
+    try:
+        build_seeds(config)
+    except ValueError as error:
+        raise UsageError(f"--terrains-per-family, --jittered-terrains-per-family: {error}") from None
     scenes = _scenes(args.scenes or [])
     report = build(out, config, scenes, cache=Path(args.cache), workers=args.workers)
     print(report_table(report), end="")
@@ -263,6 +276,19 @@ def _register_walkability(targets) -> None:
         type=positive_int,
         default=None,
         help="pose draws per held-out terrain (default 50)",
+    )
+    parser.add_argument(
+        "--jittered-terrains-per-family",
+        type=non_negative_int,
+        default=None,
+        help="more fitting terrains per training family whose root heights are jittered (default 40)",
+    )
+    parser.add_argument(
+        "--root-height-jitter",
+        type=non_negative_float,
+        default=None,
+        metavar="M",
+        help="largest move of a jittered root height from the lattice's, m (default 0.10; 0: no jittered test)",
     )
     parser.add_argument(
         "--scenes", nargs="*", metavar="GLOB", help="terrain files whose poses test the model too"

@@ -261,9 +261,9 @@ QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.
 # walkability model, which ends an episode on every stair flight the generator climbs, at poses
 # its own walking truth walks (the model's errors, 4.3 % of walkable poses on unseen terrains,
 # are too many for a check that each of 400 poses must pass). Those policies trained on the
-# model fitted on 4 terrains per family; the model now shipped (120 small terrains per family)
-# rejects 5.7 % and still ends every one of those stair guides
-# (docs/results/2026-12-07-walkability-many-terrains). With the arena-fitted condition
+# model fitted on 4 terrains per family; the model now shipped (120 small terrains per family,
+# 40 more at jittered root heights) still ends every one of those stair guides, with runs of 3-53
+# rejected poses (docs/results/2026-12-07-walkability-root-heights). With the arena-fitted condition
 # instead a policy climbs eval_stairs but walks less than the paper-arena policy on every arena,
 # so neither change is made here.
 GENERALIST_ENV = dataclasses.replace(

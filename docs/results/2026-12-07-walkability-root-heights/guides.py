@@ -3,7 +3,8 @@
 For each successful guide of `leas evaluate` folders (the plan covers the guide and ends at the
 target), a pose is rejected where the plausible cylinders or the model's network reject it at the
 guide's own root height (the env's `walkability` condition). Prints, per model and scenario, the
-guides with a rejected pose, the share of poses rejected, and the longest run of consecutive
+guides with a rejected pose (and those where the plausible cylinders reject one, whatever the
+network says), the share of poses rejected, and the longest run of consecutive
 rejected poses per guide (what a termination that waits that many steps would let pass), and the
 root height's distance from the lattice's nominal height (5 / 50 / 95 %).
 
@@ -15,10 +16,23 @@ root height's distance from the lattice's nominal height (5 / 50 / 95 %).
 from __future__ import annotations
 
 import argparse
+import collections
 import json
 from pathlib import Path
 
 import numpy as np
+
+# `reachability.margins` of the plausible cylinders (no lookahead, no foothold): the trunk, the
+# ground under each leg too far below (leg_bottom) and too high (leg_top), each hand
+TERMS = (
+    "trunk",
+    "left leg's ground too low",
+    "right leg's ground too low",
+    "left leg's ground too high",
+    "right leg's ground too high",
+    "left hand",
+    "right hand",
+)
 
 
 def runs(rejected: np.ndarray) -> list[int]:
@@ -46,22 +60,25 @@ def main() -> None:
     reach = ReachabilityConfig()
     relaxed = reachability.relaxed_reachability(reach)
     models = {n: wk.load_walkability(p, reach) for n, p in (s.split("=", 1) for s in args.models)}
-    print("| model | scenario | guides ended | poses rejected | longest rejected run per guide (poses) |")
-    print("|---|---|---|---|---|")
+    print(
+        "| model | scenario | guides ended | of them by the plausible cylinders | poses rejected | "
+        "longest rejected run per guide (poses) |"
+    )
+    print("|---|---|---|---|---|---|")
     heights = {}
+    failing = collections.defaultdict(collections.Counter)
     for name, model in models.items():
         for folder in map(Path, args.guides):
             results = json.loads((folder / "results.json").read_text())
             with np.load(folder / "guides.npz") as stored:
                 for scenario, entry in results["scenarios"].items():
                     field = wk._field(load_terrain(resolve_data_path(entry["terrain"])))
-                    rejected_by = jax.jit(
+                    verdicts = jax.jit(
                         jax.vmap(
                             lambda q, f=field, m=model: (
-                                ~(
-                                    reachability.valid(f, q, relaxed)
-                                    & (lf.logit(m, f, q, reach) >= m["threshold"])
-                                )
+                                reachability.valid(f, q, relaxed),
+                                lf.logit(m, f, q, reach) >= m["threshold"],
+                                reachability.margins(f, q, relaxed),
                             )
                         )
                     )
@@ -70,12 +87,19 @@ def main() -> None:
                         for k, t in enumerate(entry["trajectories"])
                         if t["success"]
                     ]
-                    rejected = [np.asarray(rejected_by(g)) for g in guides]
+                    plausible, network, margins = zip(
+                        *[map(np.asarray, verdicts(g)) for g in guides], strict=True
+                    )
+                    for p, m in zip(plausible, margins, strict=True):
+                        failing[scenario].update(TERMS[int(np.argmin(row))] for row in m[~p])
+                    rejected = [~(p & n) for p, n in zip(plausible, network, strict=True)]
+                    implausible = sum((~p).any() for p in plausible)
                     longest = sorted(max(runs(r), default=0) for r in rejected)
                     share = 100 * np.mean(np.concatenate(rejected))
                     ended = sum(r.any() for r in rejected)
                     print(
-                        f"| {name} | {scenario} | {ended} / {len(guides)} | {share:.1f} % | "
+                        f"| {name} | {scenario} | {ended} / {len(guides)} | {implausible} / {len(guides)} | "
+                        f"{share:.1f} % | "
                         f"{', '.join(map(str, longest))} |"
                     )
                     nominal = [
@@ -83,6 +107,8 @@ def main() -> None:
                         for g in guides
                     ]
                     heights[scenario] = np.percentile(np.concatenate(nominal), [5, 50, 95])
+    print("\nPoses the plausible cylinders reject, by their most violated term (both models): ", end="")
+    print("; ".join(f"{s} {dict(c)}" for s, c in failing.items() if c) or "none")
     print("\nRoot height minus the lattice's (m), 5 / 50 / 95 %: ", end="")
     print("; ".join(f"{s} {' / '.join(f'{v:+.3f}' for v in p)}" for s, p in heights.items()))
 

@@ -211,6 +211,35 @@ def test_the_walkability_condition_is_the_plausible_cylinders_and_the_network():
     assert 0 < int(verdict.sum()) < n and int((np.asarray(network) & ~np.asarray(plausible)).sum()) > 0
 
 
+def test_the_condition_threshold_moves_the_networks_boundary_and_none_keeps_the_stored_one():
+    """`EnvConfig.condition_threshold` replaces the threshold stored with the weights: a lower
+    logit accepts a superset of the poses, and the generalist preset sets one."""
+    from leas_jax.env.learned_weights import condition_params, load_params
+
+    stored = float(load_params(TERRAINS.parent / GENERALIST_ENV.learned_weights)[0]["threshold"])
+    own = dataclasses.replace(GENERALIST_ENV, condition_threshold=None)
+    assert float(condition_params(own)["threshold"]) == pytest.approx(stored)
+    assert GENERALIST_ENV.condition_threshold is not None and GENERALIST_ENV.condition_threshold < stored
+    terrain = loads_terrain(family_terrain("stairs", 4))
+    rng = np.random.default_rng(1)
+    poses = np.stack(
+        [
+            rng.uniform(0.3, 5.7, 400),
+            rng.uniform(0.3, 2.7, 400),
+            rng.uniform(0.8, 1.4, 400),
+            rng.uniform(-3, 3, 400),
+        ],
+        axis=1,
+    ).astype(np.float32)
+
+    def accepted(config):
+        field = heightfield_from_terrain(terrain, config)
+        return np.asarray(jax.vmap(lambda p: env_condition.valid(field, p, config))(poses))
+
+    strict, lenient = accepted(own), accepted(GENERALIST_ENV)
+    assert np.all(lenient[strict]) and lenient.sum() > strict.sum()
+
+
 def test_the_generalist_preset_trains_on_the_curriculum_with_the_walkability_model():
     config = preset("generalist")
     assert config.env.condition == "walkability"

@@ -195,6 +195,10 @@ class EnvConfig:
     # of the cylinders in both cases (a fallback that is valid for every yaw).
     condition: str = "cylinders"
     learned_weights: str = "checkpoints/feasibility/walking.npz"
+    # The network's decision threshold (a logit) as a termination, where it is not the one stored
+    # with its weights; None: the stored one. The walkability model stores the lattice's, set for
+    # 95 % sensitivity on single poses; an episode must pass 400 of them.
+    condition_threshold: float | None = None
     reachability: ReachabilityConfig = field(default_factory=ReachabilityConfig)
     curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)
     heightmap: HeightmapConfig = field(default_factory=HeightmapConfig)

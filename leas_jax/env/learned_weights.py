@@ -84,7 +84,8 @@ def load_params(path: str | Path) -> tuple[LearnedParams, dict]:
 
 def condition_params(config: EnvConfig) -> dict:
     """The network's parameters when `config.condition` is "learned" or "walkability" (both read
-    `config.learned_weights`), else {} (host)."""
+    `config.learned_weights`; the threshold `config.condition_threshold` where it is set), else
+    {} (host)."""
     if config.condition == "cylinders":
         return {}
     if config.condition not in ("learned", "walkability"):
@@ -106,4 +107,6 @@ def condition_params(config: EnvConfig) -> dict:
             f"{path}: the learned condition was fitted on the margins of another ReachabilityConfig "
             f"({fitted}); build the env with that EnvConfig.reachability"
         )
+    if config.condition_threshold is not None:
+        params = {**params, "threshold": jnp.asarray(config.condition_threshold, jnp.float32)}
     return params

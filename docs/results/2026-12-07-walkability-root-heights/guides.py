@@ -5,7 +5,9 @@ target), a pose is rejected where the plausible cylinders or the model's network
 guide's own root height (the env's `walkability` condition). Prints, per model and scenario, the
 guides with a rejected pose (and those where the plausible cylinders reject one, whatever the
 network says), the share of poses rejected, and the longest run of consecutive
-rejected poses per guide (what a termination that waits that many steps would let pass), and the
+rejected poses per guide (what a termination that waits that many steps would let pass), the range
+over guides of the lowest network logit among its plausible poses (a threshold below it ends none
+of them), and the
 root height's distance from the lattice's nominal height (5 / 50 / 95 %).
 
     python docs/results/2026-12-07-walkability-root-heights/guides.py \
@@ -62,9 +64,9 @@ def main() -> None:
     models = {n: wk.load_walkability(p, reach) for n, p in (s.split("=", 1) for s in args.models)}
     print(
         "| model | scenario | guides ended | of them by the plausible cylinders | poses rejected | "
-        "longest rejected run per guide (poses) |"
+        "longest rejected run per guide (poses) | lowest logit of a plausible pose per guide (range) |"
     )
-    print("|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|")
     heights = {}
     failing = collections.defaultdict(collections.Counter)
     for name, model in models.items():
@@ -77,7 +79,7 @@ def main() -> None:
                         jax.vmap(
                             lambda q, f=field, m=model: (
                                 reachability.valid(f, q, relaxed),
-                                lf.logit(m, f, q, reach) >= m["threshold"],
+                                lf.logit(m, f, q, reach),
                                 reachability.margins(f, q, relaxed),
                             )
                         )
@@ -87,9 +89,11 @@ def main() -> None:
                         for k, t in enumerate(entry["trajectories"])
                         if t["success"]
                     ]
-                    plausible, network, margins = zip(
+                    plausible, logits, margins = zip(
                         *[map(np.asarray, verdicts(g)) for g in guides], strict=True
                     )
+                    network = [lg >= float(model["threshold"]) for lg in logits]
+                    lowest = [float(lg[p].min()) for lg, p in zip(logits, plausible, strict=True) if p.any()]
                     for p, m in zip(plausible, margins, strict=True):
                         failing[scenario].update(TERMS[int(np.argmin(row))] for row in m[~p])
                     rejected = [~(p & n) for p, n in zip(plausible, network, strict=True)]
@@ -100,7 +104,7 @@ def main() -> None:
                     print(
                         f"| {name} | {scenario} | {ended} / {len(guides)} | {implausible} / {len(guides)} | "
                         f"{share:.1f} % | "
-                        f"{', '.join(map(str, longest))} |"
+                        f"{', '.join(map(str, longest))} | {min(lowest):.1f} .. {max(lowest):.1f} |"
                     )
                     nominal = [
                         np.asarray(g[:, 2] - sample_nearest(field, field.leg_max, g[:, :2])) - 1.0

@@ -265,7 +265,7 @@ def main() -> None:
                 scene,
                 scene.name,
                 config.test_poses_per_terrain,
-                config.seed + 1000 + k,
+                wk.scene_seed(config, k),
                 config,
                 cache,
                 args.workers,

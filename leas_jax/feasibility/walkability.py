@@ -53,6 +53,7 @@ HELD_OUT = ("blocks", "stones")  # families kept out of the fit: the report's ge
 TEST_SEEDS = 10_000
 JITTERED_TEST_OFFSET = 1_000
 HELD_OUT_SEEDS = 200
+SCENE_SEEDS = 1_000  # the pose draws of the k-th scene: seed config.seed + SCENE_SEEDS + k (`scene_seed`)
 
 
 @dataclass(frozen=True)
@@ -426,6 +427,11 @@ def family_sets(
 # ---- fit and report ----------------------------------------------------------------------------
 
 
+def scene_seed(config: WalkabilityConfig, index: int) -> int:
+    """The seed of the pose draws on a build's `index`-th scene."""
+    return config.seed + SCENE_SEEDS + index
+
+
 @dataclass(frozen=True)
 class BuildSeeds:
     """Terrain seeds of a build: of the training families, the fit at nominal root heights and
@@ -604,7 +610,7 @@ def build(
             scene,
             scene.name,
             config.test_poses_per_terrain,
-            config.seed + 1000 + k,
+            scene_seed(config, k),
             config,
             cache,
             workers,

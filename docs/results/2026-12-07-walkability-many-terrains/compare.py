@@ -162,7 +162,7 @@ def main() -> None:
             scene,
             scene.name,
             config.poses_per_terrain,
-            config.seed + 1000 + k,
+            wk.scene_seed(config, k),
             config,
             cache,
             args.workers,

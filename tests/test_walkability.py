@@ -248,9 +248,15 @@ def test_jittered_poses_are_the_lattices_poses_moved_up_or_down():
     moved = np.array([p[2] - index[tuple(p[[0, 1, 3]])] for p in jittered])  # KeyError: a new draw
     assert np.abs(moved).max() <= 0.1 + 1e-6 and np.abs(moved).max() > 0.05
     assert 0.5 * len(nominal) < len(jittered) <= len(nominal)
-    relaxed = wk.relaxed_reachability(ReachabilityConfig())
-    assert wk._valid_at(field, jittered, relaxed).all()
-    assert np.array_equal(cylinders, wk._valid_at(field, jittered, ReachabilityConfig()))
+    from leas_jax.env import reachability
+
+    def valid(reach):
+        return np.asarray(
+            reachability.valid_poses(field, jax.numpy.asarray(jittered, jax.numpy.float32), reach)
+        )
+
+    assert valid(wk.relaxed_reachability(ReachabilityConfig())).all()
+    assert np.array_equal(cylinders, valid(ReachabilityConfig()))
     assert nominal_cylinders.any() and cylinders.any() and not cylinders.all()
 
 

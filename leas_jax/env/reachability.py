@@ -157,6 +157,12 @@ def valid(
     return functools.reduce(jnp.logical_and, terms(field, pose, config).values())
 
 
+@functools.partial(jax.jit, static_argnums=2)
+def valid_poses(field: Heightfield, poses: jax.Array, config: ReachabilityConfig) -> jax.Array:
+    """`valid` of many poses, jitted and vmapped. poses: [N, 4] (x, y, z, yaw), world -> bool [N]."""
+    return jax.vmap(lambda pose: valid(field, pose, config))(poses)
+
+
 MARGIN_CLIP = 1.0  # m, |margin| kept (an infinite raster value, e.g. no solid ground, reads as 1 m)
 
 

@@ -104,11 +104,9 @@ def policy_poses(policy, terrain, count: int, seed: int, per_guide: int = 4, ste
 def cylinder_verdicts(terrain, poses: np.ndarray, config) -> np.ndarray:
     """[N] bool `reachability.valid` (jitted, vmapped) at poses [N, 4] with `config` (a
     `ReachabilityConfig`), on the terrain's heightfield built for that config."""
-    import jax
     import jax.numpy as jnp
 
     from leas_jax.env import EnvConfig, heightfield_from_terrain, reachability
 
     field = heightfield_from_terrain(terrain, EnvConfig(reachability=config))
-    valid = jax.jit(jax.vmap(lambda f, p: reachability.valid(f, p, config), in_axes=(None, 0)))
-    return np.asarray(valid(field, jnp.asarray(poses, dtype=jnp.float32)))
+    return np.asarray(reachability.valid_poses(field, jnp.asarray(poses, dtype=jnp.float32), config))

@@ -269,19 +269,10 @@ def plausible_poses(
     poses = np.column_stack([planar[:, :2], z, planar[:, 2]])
     if height_jitter > 0.0:
         poses[:, 2] += rng.uniform(-height_jitter, height_jitter, count)
-        maybe &= _valid_at(field, poses, relaxed_reachability(reach))
-        cylinders = maybe & _valid_at(field, poses, reach)
+        moved = jnp.asarray(poses, jnp.float32)
+        maybe &= np.asarray(reachability.valid_poses(field, moved, relaxed_reachability(reach)))
+        cylinders = maybe & np.asarray(reachability.valid_poses(field, moved, reach))
     return poses[maybe], cylinders[maybe]
-
-
-def _valid_at(field, poses: np.ndarray, reach) -> np.ndarray:
-    """bool [N]: `reachability.valid` of poses [N, 4] (x, y, z, yaw), world (host)."""
-    return np.asarray(_valid_poses(field, jnp.asarray(poses, jnp.float32), reach))
-
-
-@functools.partial(jax.jit, static_argnums=(2,))
-def _valid_poses(field, poses, reach):
-    return jax.vmap(lambda pose: reachability.valid(field, pose, reach))(poses)
 
 
 _WORKER = {}
@@ -396,7 +387,9 @@ def family_sets(
     from leas_jax.terrain import loads_terrain
 
     out = []
-    for family in families if len(seeds) else ():
+    if not len(seeds):
+        return out
+    for family in families:
         began = time.perf_counter()
         parts = []
         for seed in tqdm(seeds, desc=f"{family}: labelling", unit="terrain", leave=False, disable=None):
@@ -570,17 +563,12 @@ def build(
             height_jitter=jitter,
         )
     )
-    test_sets = {"unseen terrains of the training families": (seeds.test, 0.0)}
-    if jitter > 0.0:
-        test_sets[f"unseen terrains of the training families, root heights +-{jitter:g} m"] = (
-            seeds.jittered_test,
-            jitter,
-        )
-    tests = {
-        name: concatenate(
+
+    def tested(terrains, height_jitter):
+        return concatenate(
             family_sets(
                 config.train_families,
-                test_seeds,
+                terrains,
                 config,
                 cache,
                 workers,
@@ -590,8 +578,11 @@ def build(
                 height_jitter,
             )
         )
-        for name, (test_seeds, height_jitter) in test_sets.items()
-    }
+
+    tests = {"unseen terrains of the training families": tested(seeds.test, 0.0)}
+    if jitter > 0.0:
+        name = f"unseen terrains of the training families, root heights +-{jitter:g} m"
+        tests[name] = tested(seeds.jittered_test, jitter)
     held = concatenate(
         family_sets(
             config.held_out_families,

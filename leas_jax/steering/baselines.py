@@ -81,11 +81,6 @@ def _heights(field: Heightfield, xy: jax.Array) -> jax.Array:
     return sample_bilinear(field, xy)
 
 
-@functools.partial(jax.jit, static_argnums=2)
-def _valid(field: Heightfield, poses: jax.Array, config: ReachabilityConfig) -> jax.Array:
-    return jax.vmap(lambda pose: reachability.valid(field, pose, config))(poses)
-
-
 def _padded(array: np.ndarray) -> tuple[np.ndarray, int]:
     """Pad rows to a multiple of _PAD by repeating the last row (or zeros if empty)."""
     n = len(array)
@@ -186,7 +181,7 @@ def valid_poses(field: Heightfield, poses, config: ReachabilityConfig = Reachabi
     """
     poses = np.asarray(poses, np.float32).reshape(-1, 4)
     padded, n = _padded(poses)
-    return np.asarray(_valid(field, jnp.asarray(padded), config))[:n]
+    return np.asarray(reachability.valid_poses(field, jnp.asarray(padded), config))[:n]
 
 
 def heading_from_velocity(velocity, initial_yaw: float) -> np.ndarray:

@@ -118,7 +118,8 @@ class Part:
 
 
 def labelled(terrain, group, count, seed, config, cache, workers, grid, planes_of, band):
-    """`Part` of one terrain: the build's poses (same draws), cached labels, both feature sets."""
+    """`Part` of one terrain: the build's poses (same draws; `band` as `plausible_poses` takes
+    it), cached labels, both feature sets."""
     import jax.numpy as jnp
 
     from leas_jax.env.config import ReachabilityConfig
@@ -126,10 +127,7 @@ def labelled(terrain, group, count, seed, config, cache, workers, grid, planes_o
     from leas_jax.feasibility.fit import features_of
 
     field = wk._field(terrain)
-    if band is None:
-        poses, _ = wk.plausible_poses(field, terrain.bounds, count, seed, config, None)
-    else:
-        poses, _ = wk.plausible_poses(field, terrain.bounds, count, seed, config)
+    poses, _ = wk.plausible_poses(field, terrain.bounds, count, seed, config, band)
     labels = wk.walking_labels(terrain, poses, cache, workers)
     x = features_of(grid, field, poses, ReachabilityConfig())
     planes = np.asarray(planes_of(field, jnp.asarray(poses, jnp.float32)))
@@ -206,7 +204,7 @@ def main() -> None:
     from leas_jax.feasibility import walkability as wk
     from leas_jax.feasibility.commands import _scenes
     from leas_jax.terrain import loads_terrain
-    from leas_jax.terrain.families import family_terrain
+    from leas_jax.terrain.families import FEATURE_X, family_terrain
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True)
@@ -244,7 +242,7 @@ def main() -> None:
                         args.workers,
                         grid_params,
                         planes_of,
-                        band=True,
+                        band=FEATURE_X,
                     )
                 )
             print(f"{family}: seeds {seeds[0]}-{seeds[-1]} ({time.perf_counter() - began:.0f} s)", flush=True)

@@ -36,6 +36,10 @@ Rates come with 95 % Wilson intervals.
     python studies/motion_execution.py --out docs/results/2026-12-06-motion-every-scene --starts 2 \\
         --max-plans 2 --max-postures 1000 --variant new --scenarios circuit,hpp_darpa,hpp_talos_maze
 
+`--transitions` plans with the generator's transition checks (`motion_generator_config`, as
+`leas navigate --motion` plans: each single support's lift-off, apex and touchdown reachable
+and clear as the motion moves the root); give it its own `--plans` folder.
+
 `--also VARIANT=JSON` simulates each motion once more with other SimulationConfig overrides
 (the motion made once), written as VARIANT.
 
@@ -120,7 +124,9 @@ HPP_FILES = {
 } | {f"hpp_{n}": f"terrains/hpp/rough/{n}.toml" for n in ROUGH_SCENES}
 
 
-def make_plans(name: str, starts: int, ground_starts: int, cache: Path, checkpoint=None) -> list[Path]:
+def make_plans(
+    name: str, starts: int, ground_starts: int, cache: Path, checkpoint=None, generator_config=None
+) -> list[Path]:
     """Plan files of `name`'s covered RBLin plans, planned now unless cached.
 
     Args:
@@ -129,6 +135,7 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path, checkpoi
         ground_starts: starts per cell of `ground` (Table II's nine cells).
         cache: folder of the plan files.
         checkpoint: the policy of the navigate method (METHODS).
+        generator_config: the contact generator's `GeneratorConfig` (None: its defaults).
 
     Returns:
         paths of the covered plans' files (world frame, the generator's ContactPlan format).
@@ -154,7 +161,9 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path, checkpoi
         policy = policy_for((method,), checkpoint)
     files, note = [], None
     try:
-        result = run_scenario(name, terrain, (method,), policy, per_cell, 0, progress=False)
+        result = run_scenario(
+            name, terrain, (method,), policy, per_cell, 0, progress=False, generator_config=generator_config
+        )
     except UsageError as exc:
         if not (name.startswith("hpp_talos") and method == "navigate"):
             raise
@@ -163,7 +172,7 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path, checkpoi
         # studies/navigate_demos.py run it; its plan counts when reached and verified.
         note = f"evaluation start refused ({exc}); planned as `leas navigate` plans the query"
         starts = 1
-        if demo_plan(terrain, policy, cache / f"{name}_0.npz"):
+        if demo_plan(terrain, policy, cache / f"{name}_0.npz", generator_config):
             files.append(f"{name}_0.npz")
     else:
         starts = len(result.trajectories)
@@ -186,18 +195,20 @@ def make_plans(name: str, starts: int, ground_starts: int, cache: Path, checkpoi
     return [cache / f for f in files]
 
 
-def demo_plan(terrain, policy, path: Path) -> bool:
+def demo_plan(terrain, policy, path: Path, generator_config=None) -> bool:
     """Navigate a demo terrain's one query (start at rest, yaw relative to the direction to the
     target) in this process; save the plan at `path` when the goal is reached and the plan
     passes `leas_jax.contacts.verify`. Returns whether it was saved."""
     from leas_jax.contacts import verify
     from leas_jax.navigate import navigate
+    from leas_jax.navigate.loop import NavigateConfig
 
     scenario = terrain.scenario
     (x0, y0), _ = scenario.start_region
     gx, gy = (float(v) for v in scenario.target)
     yaw = math.atan2(gy - y0, gx - x0) + math.radians(float(scenario.start_yaw_deg[0]))
-    result = navigate(policy, terrain, (float(x0), float(y0), yaw), (gx, gy), workers=0)
+    config = NavigateConfig() if generator_config is None else NavigateConfig(generator=generator_config)
+    result = navigate(policy, terrain, (float(x0), float(y0), yaw), (gx, gy), config, workers=0)
     if not (result.success and result.plan is not None and verify(result.plan).ok):
         return False
     result.plan.save(path)
@@ -254,6 +265,11 @@ def run(args) -> dict:
     cache = Path(args.plans)
     cache.mkdir(parents=True, exist_ok=True)
     motion_config = MotionConfig(**json.loads(args.motion_config))
+    generator = None
+    if args.transitions:
+        from leas_jax.contacts.planner.config import motion_generator_config
+
+        generator = motion_generator_config()
     # (variant, SimulationConfig overrides): the first's simulation is execute_plan's, the
     # others (--also) simulate the same motion again
     variants = [(args.variant, json.loads(args.simulation_config))]
@@ -274,6 +290,7 @@ def run(args) -> dict:
             "ground_starts_per_cell": args.ground_starts,
             "max_plans": args.max_plans,
             "max_postures": args.max_postures,
+            "transitions_checked": args.transitions,
             "scenarios": {},
         }
         json_path = out / f"motion_execution_{variant}.json"
@@ -285,7 +302,7 @@ def run(args) -> dict:
                     e["cause"] = cause(e)
         reports[variant] = report
     for name in names:
-        plans = make_plans(name, args.starts, args.ground_starts, cache, args.checkpoint)
+        plans = make_plans(name, args.starts, args.ground_starts, cache, args.checkpoint, generator)
         if args.max_plans:
             plans = plans[: args.max_plans]
         executions, skipped = {variant: [] for variant, _ in variants}, []
@@ -469,6 +486,12 @@ def main(argv=None) -> int:
         "--checkpoint", default=str(ROOT / "checkpoints/leas_talos"), help="navigate's policy"
     )
     parser.add_argument("--plans", default=str(ROOT / "runs/motion_plans"), help="plan cache folder")
+    parser.add_argument(
+        "--transitions",
+        action="store_true",
+        help="plan with the transitions a motion needs checked (`motion_generator_config`, as "
+        "`leas navigate --motion` plans); give another --plans folder",
+    )
     parser.add_argument(
         "--all", action="store_true", help="also the other evaluation scenarios and HPP scenes"
     )

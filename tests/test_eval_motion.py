@@ -76,6 +76,7 @@ def test_a_tiny_evaluation_executes_its_plans(tmp_path, capsys):
     assert main(args) == 0
     printed = capsys.readouterr().out
     report = json.loads((out / "results.json").read_text())
+    assert report["transitions_checked"]  # the plans made for motions had their lift-offs checked
     scenario = report["scenarios"]["motion_slab"]
     assert [t["success"] for t in scenario["trajectories"]] == [True, True]
     motion = scenario["motion"]

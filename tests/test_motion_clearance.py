@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from leas_jax.contacts.robot.clearance import BodyClearance
 from leas_jax.contacts.robot.model import load_talos
 from leas_jax.motion import motion
-from leas_jax.motion.clearance import BodyClearance
 from leas_jax.motion.config import MotionConfig
 from leas_jax.motion.paths import HELD_BULGES, LAND_WINDOWS, LIFT_WINDOWS, swing_path
 from leas_jax.terrain import loads_terrain

@@ -52,6 +52,20 @@ def test_a_motion_that_cannot_be_made_is_one_line_and_exit_code_1(tmp_path, caps
     assert "no motion:" in line and "torque limits fails" in line and "between postures" in line
 
 
+def test_a_plan_made_into_a_motion_has_its_transitions_checked():
+    import argparse
+
+    from leas_jax.contacts.planner.config import motion_generator_config
+    from leas_jax.navigate.commands import navigate_config, register
+
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers(dest="command"))
+    base = ["navigate", "--checkpoint", SHIPPED, "--terrain", WALL, "--out", "plan.npz", *QUERY]
+    assert navigate_config(parser.parse_args(base)).generator is None  # the generator's defaults
+    checked = navigate_config(parser.parse_args([*base, "--motion", "motion.npz"])).generator
+    assert checked == motion_generator_config() and checked.transitions is not None
+
+
 def test_a_bad_motion_path_is_a_usage_error_before_navigating(tmp_path, capsys):
     code, plan_file, _ = _navigate(tmp_path / "nowhere")
     err = capsys.readouterr().err.strip()

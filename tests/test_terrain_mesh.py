@@ -195,10 +195,9 @@ def test_translate_and_mixed_boxes(tmp_path):
     tops = sorted(round(float(s.vertices[:, 2].mean()), 6) for s in terrain.support_surfaces())
     assert tops == [0.0, 0.2]
     # verify's collision messages name the object: the boxes first, then the mesh tiles
-    from leas_jax.contacts.robot.collision import terrain_collision
-    from leas_jax.contacts.verify import _terrain_object
+    from leas_jax.contacts.robot.collision import terrain_collision, terrain_object_name
 
-    names = [_terrain_object(terrain, b) for b in range(len(terrain_collision(terrain).shapes))]
+    names = [terrain_object_name(terrain, b) for b in range(len(terrain_collision(terrain).shapes))]
     # the block straddles x = 2 and y = 1, the corners of four 1 m tiles
     assert names == ["terrain box 0"] + [f"terrain mesh tile {k}" for k in range(4)]
 

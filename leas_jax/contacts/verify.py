@@ -97,7 +97,7 @@ def verify(plan, terrain=None) -> VerificationReport:
     """
     from leas_jax.contacts.plan import coverage_of
     from leas_jax.contacts.planner.surfaces import find_support, surface_arrays
-    from leas_jax.contacts.robot.collision import robot_collision, terrain_collision
+    from leas_jax.contacts.robot.collision import robot_collision, terrain_collision, terrain_object_name
     from leas_jax.contacts.robot.equilibrium import HppEquilibrium, sole_corners
     from leas_jax.contacts.robot.model import load_talos
     from leas_jax.quiet import c_stdout_discarded
@@ -193,7 +193,7 @@ def verify(plan, terrain=None) -> VerificationReport:
             fail.append((k, 3, f"joint {name} = {value:.4f} outside [{lo:.4f}, {hi:.4f}]"))
         rot, pos = robot.placements_pinocchio(talos, q)
         for g, b in robot.terrain_contacts(rot, pos, objects, first_only=False):
-            fail.append((k, 3, f"{robot.names[g]} collides with {_terrain_object(terrain, b)}"))
+            fail.append((k, 3, f"{robot.names[g]} collides with {terrain_object_name(terrain, b)}"))
         for ga, gb in robot.self_contacts(rot, pos, first_only=False):
             fail.append((k, 3, f"{robot.names[ga]} collides with {robot.names[gb]}"))
 
@@ -315,9 +315,3 @@ def _same_placement(row_a: np.ndarray, row_b: np.ndarray) -> bool:
         return False
     diff = matrix_from_quat_xyzw(row_a[3:]) - matrix_from_quat_xyzw(row_b[3:])
     return bool(np.max(np.abs(diff)) <= SAME_PLACEMENT_TOL)
-
-
-def _terrain_object(terrain, index: int) -> str:
-    """Name of collision object `index` of `terrain_collision(terrain)`: its boxes, then mesh tiles."""
-    boxes = len(terrain.boxes)
-    return f"terrain box {index}" if index < boxes else f"terrain mesh tile {index - boxes}"

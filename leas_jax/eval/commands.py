@@ -54,6 +54,7 @@ def _checkpoint(args):
 
 
 def cmd_evaluate(args) -> int:
+    from leas_jax.contacts.planner.config import motion_generator_config
     from leas_jax.eval.evaluate import evaluate, parse_methods
     from leas_jax.eval.tables import table_ii_markdown
 
@@ -92,6 +93,7 @@ def cmd_evaluate(args) -> int:
         rbkino_timestep=args.rbkino_timestep,
         motion_plans=motion_plans,
         navigate_config=_navigate_config(args),
+        generator_config=motion_generator_config() if args.motion else None,
     )
     if report.get("table_ii"):
         print(table_ii_markdown(report["table_ii"]))

@@ -499,6 +499,7 @@ def run_scenario(
     address: str | None = None,
     leas_stop_at_invalid: bool = False,
     navigate_config=None,
+    generator_config=None,
 ) -> ScenarioResult:
     """Starts, guides, validation and metrics of one scenario.
 
@@ -516,7 +517,11 @@ def run_scenario(
         leas_stop_at_invalid: LeaS paths end before the first pose the reachability
             condition rejects (False: the contact generator alone judges them).
         navigate_config: `NavigateConfig` of the navigate method (None: its defaults).
+        generator_config: `GeneratorConfig` of every method's contact planning, navigate's
+            included (replacing its `NavigateConfig.generator`); None: the generator's defaults.
     """
+    import dataclasses
+
     from leas_jax.env import heightfield_from_terrain
     from leas_jax.steering.baselines import BaselineConfig
     from leas_jax.steering.rrt import RRTConfig
@@ -526,6 +531,10 @@ def run_scenario(
     env = policy_env(policy)
     config = config or BaselineConfig.from_env(env)
     field = heightfield_from_terrain(terrain, env)
+    if generator_config is not None and "navigate" in methods:
+        from leas_jax.navigate.loop import NavigateConfig
+
+        navigate_config = dataclasses.replace(navigate_config or NavigateConfig(), generator=generator_config)
     cells = cells_for(name, terrain.scenario)
     n = int(n_starts or terrain.scenario.n_starts)
     result = ScenarioResult(name, terrain, cells, tuple(methods))
@@ -555,6 +564,7 @@ def run_scenario(
         progress,
         desc=f"{name}: contact planning",
         address=address,
+        config=generator_config,
     )
     result.seconds["contact_planning"] = time.perf_counter() - began
     return result
@@ -576,6 +586,7 @@ def evaluate(
     rbkino_timestep: float | None = None,
     motion_plans: int = 0,
     navigate_config=None,
+    generator_config=None,
 ) -> dict:
     """Run scenarios and write results.json, table.md, table.csv and figures into `out`.
 
@@ -608,6 +619,8 @@ def evaluate(
             many plans that cover their guide into motions and simulate them in MuJoCo
             (`leas_jax.eval.motions`; results.json's `motion`, table.md's motion table; 0: none).
         navigate_config: `NavigateConfig` of the navigate method (None: its defaults).
+        generator_config: `GeneratorConfig` of every method's contact planning (`run_scenario`;
+            None: its defaults). `leas evaluate --motion` checks the transitions a motion needs.
 
     Returns:
         the results dictionary written to results.json.
@@ -656,6 +669,7 @@ def evaluate(
                 address=address,
                 leas_stop_at_invalid=leas_stop_at_invalid,
                 navigate_config=navigate_config,
+                generator_config=generator_config,
             )
         )
         if motion_plans > 0:
@@ -669,6 +683,8 @@ def evaluate(
     report = tables.results_dict(
         results, policy=policy, seconds=time.perf_counter() - began, leas_stop_at_invalid=leas_stop_at_invalid
     )
+    # whether the plans had their lift-offs and landings checked as they were made (`--motion`)
+    report["transitions_checked"] = generator_config is not None and generator_config.transitions is not None
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)

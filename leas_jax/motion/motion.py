@@ -395,26 +395,6 @@ def _contacts(plan: ContactPlan, k: int) -> np.ndarray:
     return ~np.isnan(plan.feet[k, :, 0])
 
 
-def _terrain_top(terrain, start: np.ndarray, end: np.ndarray) -> float:
-    """Highest terrain (m) under a sole moved straight from start [3] to end [3], world.
-
-    The terrain is sampled under the sole rectangle (its corners and centre) at 21 points
-    along the straight segment.
-    """
-    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
-
-    reach = np.hypot(SOLE_LENGTH, SOLE_WIDTH) / 2
-    line = np.linspace(start[:2], end[:2], 21)
-    offsets = np.array([[0.0, 0.0], [reach, 0.0], [-reach, 0.0], [0.0, reach], [0.0, -reach]])
-    heights = terrain.height_at((line[:, None, :] + offsets[None]).reshape(-1, 2))
-    return float(heights.max())
-
-
-def _apex(terrain, start: np.ndarray, end: np.ndarray, clearance: float) -> float:
-    """Height of a landing path's apex: `clearance` m above both ends [3] and the terrain between."""
-    return max(start[2], end[2], _terrain_top(terrain, start, end)) + clearance
-
-
 def held_root_configuration(
     talos,
     q: np.ndarray,
@@ -1036,6 +1016,7 @@ def _segment_phases(
         MotionError: the two postures differ in a way no phase sequence handles (both
             feet change, a foot moves while in contact, two single supports in a row).
     """
+    from leas_jax.contacts.planner.transitions import swing_apex, terrain_top
     from leas_jax.motion.paths import shift_duration
 
     feet_a, com_a, rot_a = frames[k]
@@ -1073,7 +1054,7 @@ def _segment_phases(
         lifted = feet_a.copy()
         lifted[swing] = feet_b[swing]
         start, end = feet_a[swing][:3, 3], feet_b[swing][:3, 3]
-        top = _terrain_top(terrain, start, end) + config.swing_clearance
+        top = terrain_top(terrain, start, end) + config.swing_clearance
         apex = max(top, start[2], end[2])
         lift = _PhaseSpec(
             "lift", (k, k + 1), swing, round(config.lift_duration / dt), feet_a, lifted, com_b, com_b,
@@ -1090,7 +1071,7 @@ def _segment_phases(
         stance = 1 - swing
         if not np.allclose(feet_a[stance], feet_b[stance], atol=1e-6):
             raise MotionError(f"postures {k} and {k + 1}: the {SIDES[stance]} (stance) sole moves")
-        apex = _apex(terrain, feet_a[swing][:3, 3], feet_b[swing][:3, 3], config.swing_clearance)
+        apex = swing_apex(terrain, feet_a[swing][:3, 3], feet_b[swing][:3, 3], config.swing_clearance)
         landed = feet_a.copy()
         landed[swing] = feet_b[swing]
         land = _PhaseSpec(
@@ -1436,8 +1417,8 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     Raises:
         MotionError: a phase cannot be made (the message names it and says why).
     """
+    from leas_jax.contacts.robot.clearance import BodyClearance
     from leas_jax.contacts.robot.model import load_talos
-    from leas_jax.motion.clearance import BodyClearance
     from leas_jax.motion.wbik import WholeBodyIK
     from leas_jax.terrain import loads_terrain
 
@@ -1607,9 +1588,9 @@ def check_motion(
     Returns:
         list of (sample index, phase index, check name, message), in time order per check.
     """
+    from leas_jax.contacts.robot.clearance import BodyClearance
     from leas_jax.contacts.robot.equilibrium import HppEquilibrium
     from leas_jax.contacts.robot.model import load_talos
-    from leas_jax.motion.clearance import BodyClearance
     from leas_jax.terrain import loads_terrain
 
     talos = load_talos()

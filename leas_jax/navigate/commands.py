@@ -38,6 +38,7 @@ def navigate_config(args):
     """`NavigateConfig` from the command's options."""
     import dataclasses
 
+    from leas_jax.contacts.planner.config import motion_generator_config
     from leas_jax.navigate.loop import NavigateConfig
 
     config = NavigateConfig()
@@ -47,6 +48,8 @@ def navigate_config(args):
         raise UsageError(f"--resolution: expected a positive number of metres, got {args.resolution}")
     return dataclasses.replace(
         config,
+        # a plan made into a motion has its lift-offs and landings checked as it is made
+        generator=motion_generator_config() if args.motion is not None else config.generator,
         max_replans=config.max_replans if args.max_replans is None else args.max_replans,
         path_fallback=not args.policy_only,
         lattice=dataclasses.replace(

@@ -14,7 +14,8 @@ modules of this package:
 4. `footholds`: the ranked sole placements of a step (leg sample database, support
    surfaces, narrow-beam lanes).
 5. `projection`: every posture of the stages above, root placed and checked (IK and joint
-   limits, terrain and self collision, equilibrium).
+   limits, terrain and self collision, equilibrium); with `GeneratorConfig.transitions`, also
+   each single support's lift-off and landing (`transitions`).
 6. The generator stops at the first planning pose it cannot pass; `last_valid_index`
    is the guide index of the last posture, `coverage` its arc-length fraction.
 
@@ -34,6 +35,7 @@ from leas_jax.contacts.planner.footholds import Footholds
 from leas_jax.contacts.planner.projection import ContactPosture, PostureProjection
 from leas_jax.contacts.planner.stance import initial_stance
 from leas_jax.contacts.planner.surfaces import surface_arrays
+from leas_jax.contacts.planner.transitions import TransitionCheck
 from leas_jax.contacts.planner.walking import Walking
 from leas_jax.contacts.robot.database import leg_database
 from leas_jax.contacts.robot.model import LEFT, NOMINAL_ROOT_HEIGHT, RIGHT, load_talos
@@ -61,7 +63,12 @@ class ContactGenerator:
         databases = (leg_database(LEFT, config.database), leg_database(RIGHT, config.database))
         self.projection = PostureProjection(terrain, self.talos, config)
         self.footholds = Footholds(terrain, self.talos, surface_arrays(terrain, config.mu), databases, config)
-        self.walking = Walking(self.projection, self.footholds, config)
+        transitions = (
+            None
+            if config.transitions is None
+            else TransitionCheck(terrain, self.projection, config.transitions)
+        )
+        self.walking = Walking(self.projection, self.footholds, config, transitions)
 
     def double_support(self, pose) -> ContactPosture | None:
         """The first posture of a plan whose guide starts at `pose`, or None.

@@ -24,6 +24,7 @@ import numpy as np
 from leas_jax.contacts.planner.config import GeneratorConfig
 from leas_jax.contacts.planner.footholds import SCREEN_CHUNK, Footholds
 from leas_jax.contacts.planner.projection import ContactPosture, PostureProjection, rotz
+from leas_jax.contacts.planner.transitions import TransitionCheck
 from leas_jax.contacts.robot.model import LEFT, RIGHT, SOLE_LENGTH, SOLE_WIDTH
 
 
@@ -34,12 +35,21 @@ class Walking:
         projection: the terrain's posture projection.
         footholds: the terrain's footholds.
         config: generator settings.
+        transitions: None, or the lift-offs and landings to check as single supports and
+            footholds are chosen (`GeneratorConfig.transitions`).
     """
 
-    def __init__(self, projection: PostureProjection, footholds: Footholds, config: GeneratorConfig):
+    def __init__(
+        self,
+        projection: PostureProjection,
+        footholds: Footholds,
+        config: GeneratorConfig,
+        transitions: TransitionCheck | None = None,
+    ):
         self.projection = projection
         self.footholds = footholds
         self.config = config
+        self.transitions = transitions
         self._nominal_xy = [tuple(row[:2].tolist()) for row in projection.talos.nominal_sole_in_root]
 
     def _foot_lag(self, guide_pose, side, pos, rot) -> tuple[float, float]:
@@ -119,19 +129,32 @@ class Walking:
         # shin meets a foot held under its hip.
         outward = rotz(pose[3])[:, 1] * (1.0 if side == LEFT else -1.0)
         lifted.append((nominal_pos + cfg.swing_clearance * outward, rotz(pose[3]), True))
-        single = self.projection.posture(
-            pose, index, [stance], air=(side, lifted), com_target=feet[other][0][:2]
-        )
+        single = self._lifted(pose, index, stance, (side, lifted), feet[other][0][:2], feet[side])
         if single is None and cfg.single_support_com_inset is not None:
             # The root shift that brings the CoM over the sole's centre can put the body into
-            # the terrain (an arm into a pillar beside the path); a CoM target on the sole,
-            # inset from its edges, nearer the guide, needs a shorter shift.
+            # the terrain (an arm into a pillar beside the path), or a crouched swing knee
+            # against the stance knee at lift-off; a CoM target on the sole, inset from its
+            # edges, nearer the guide, needs a shorter shift.
             nearer = self._sole_point_toward(feet[other], pose[:2], cfg.single_support_com_inset)
-            single = self.projection.posture(pose, index, [stance], air=(side, lifted), com_target=nearer)
+            single = self._lifted(pose, index, stance, (side, lifted), nearer, feet[side])
         if single is None:
             return None, False
-        double, held_back = self._land(pose, index, feet, side, stance, target_pos, target_yaw, min_gain)
+        double, held_back = self._land(
+            pose, index, feet, side, stance, target_pos, target_yaw, min_gain, single
+        )
         return (None if double is None else [single, double]), held_back
+
+    def _lifted(self, pose, index: int, stance, air, com_target, contact) -> ContactPosture | None:
+        """The one-foot posture (`PostureProjection.posture` with `air`, the CoM aimed at
+        com_target [2]) whose swing foot can leave `contact` (pos [3], rot [3, 3]) where
+        transitions are checked (`TransitionCheck.lift_off`), or None."""
+        single = self.projection.posture(pose, index, [stance], air=air, com_target=com_target)
+        if single is None or self.transitions is None:
+            return single
+        if self.transitions.lift_off(single, air[0], contact) is not None:
+            self.projection.count_rejection("transition: lift-off")
+            return None
+        return single
 
     def _swing_lift(self, old_pos, target_pos) -> float:
         """m, how high above its last contact old_pos [3] a foot stepping toward target_pos
@@ -143,13 +166,23 @@ class Walking:
         return cfg.swing_lift
 
     def _land(
-        self, pose, index: int, feet, side: int, stance, target_pos, target_yaw: float, min_gain
+        self,
+        pose,
+        index: int,
+        feet,
+        side: int,
+        stance,
+        target_pos,
+        target_yaw: float,
+        min_gain,
+        single: ContactPosture,
     ) -> tuple[ContactPosture | None, bool]:
         """The double-support posture of foot `side` landing near a step target (mutates
         `feet` on success), and whether `min_gain` passed over a placement (see `step`).
 
         pose: [4] planning pose; stance: (side, pos [3], rot [3, 3]) of the other sole;
-        target_pos: [3] world; target_yaw: rad."""
+        target_pos: [3] world; target_yaw: rad; single: the one-foot posture the foot lands
+        from (its landing checked where transitions are, `TransitionCheck.landing`)."""
         cfg = self.config
         old_pos = feet[side][0]
         # Same candidates, in the same order, as `candidates(...)[:max_candidates]`, but
@@ -174,6 +207,10 @@ class Walking:
                 if not self.comfortable(pose, contacts[1:]):
                     continue
                 double = self.projection.posture(pose, index, contacts)
+                if double is not None and self.transitions is not None:
+                    if self.transitions.landing(single, side, (pos, rot), double) is not None:
+                        self.projection.count_rejection("transition: landing")
+                        continue
                 if double is not None:
                     feet[side] = (pos, rot)
                     return double, held_back

@@ -84,6 +84,12 @@ def terrain_collision(terrain) -> TerrainCollision:
     return cached
 
 
+def terrain_object_name(terrain, index: int) -> str:
+    """Name of collision object `index` of `terrain_collision(terrain)`: its boxes, then mesh tiles."""
+    boxes = len(terrain.boxes)
+    return f"terrain box {index}" if index < boxes else f"terrain mesh tile {index - boxes}"
+
+
 def mesh_tiles(triangles: np.ndarray, tile: float) -> list[np.ndarray]:
     """Triangles [F, 3, 3] grouped by the square tile (side `tile`, m) holding their centroid's xy.
 

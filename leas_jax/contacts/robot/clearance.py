@@ -1,12 +1,12 @@
-"""Collisions and terrain clearance of Talos's configurations along a motion (coal, host-only).
+"""Collisions and terrain clearance of any configuration of Talos (coal, host-only).
 
 A contact plan's key postures pass the verifier's collision check (`contacts.verify`, check
 3): every collision mesh of Talos against the terrain, the feet's raised by FOOT_CLEARANCE
 along the sole normal, and the legs against the rest of the body. `BodyClearance.collisions`
-applies that same check to any configuration of a motion. `BodyClearance.too_close` asks
-more of the geometries other than the feet: that they keep a margin from the terrain, which
-a tracked motion needs (MuJoCo's tracking error is 1-1.5 cm on the CoM; a stance knee that the
-planned motion brings within 2 mm of a stair's nosing touches it in simulation).
+applies that same check to any configuration (a motion's samples, the generator's transitions
+between key postures). `BodyClearance.too_close` asks more of the geometries other than the
+feet: that they keep a margin from the terrain, which a tracked motion needs (MuJoCo's
+tracking error is 1-1.5 cm on the CoM; a stance knee that the planned motion brings within 2 mm of a stair's nosing touches it in simulation).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ class BodyClearance:
 
     Args:
         talos: `load_talos()`.
-        terrain: the motion's terrain (boxes and meshes).
+        terrain: a leas_jax.terrain.Terrain (boxes and meshes).
     """
 
     def __init__(self, talos, terrain):
@@ -37,9 +37,9 @@ class BodyClearance:
         return rot, pos, self.robot.world_aabb(rot, pos)
 
     def _object_name(self, index: int) -> str:
-        from leas_jax.contacts.verify import _terrain_object
+        from leas_jax.contacts.robot.collision import terrain_object_name
 
-        return _terrain_object(self.terrain, index)
+        return terrain_object_name(self.terrain, index)
 
     def _pair(self, g: int, b: int, rot: np.ndarray, pos: np.ndarray) -> tuple:
         """coal's arguments of geometry g at its placement (rot [G, 3, 3], pos [G, 3]) and terrain object b."""

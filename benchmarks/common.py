@@ -85,12 +85,13 @@ def add_generator_settings_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def generator_settings(assignments: list[str], parser) -> dict:
-    """{field: value} from `--set NAME=VALUE` arguments (VALUE a Python literal); a
+    """{field: value} from `--set NAME=VALUE` arguments (VALUE a Python literal; for
+    `transitions` a dict of `TransitionConfig` fields, `'transitions={}'` its defaults); a
     malformed one, or a name GeneratorConfig has not, ends the run naming it."""
     import ast
     import dataclasses
 
-    from leas_jax.contacts.planner.config import GeneratorConfig
+    from leas_jax.contacts.planner.config import GeneratorConfig, TransitionConfig
 
     fields = {f.name for f in dataclasses.fields(GeneratorConfig)}
     settings = {}
@@ -101,6 +102,10 @@ def generator_settings(assignments: list[str], parser) -> dict:
             parser.error(f"--set {assignment!r}: expected NAME=VALUE with NAME a GeneratorConfig field")
         try:
             settings[name] = ast.literal_eval(text.strip())
-        except (ValueError, SyntaxError):
-            parser.error(f"--set {assignment!r}: VALUE must be a Python literal")
+            if name == "transitions" and isinstance(settings[name], dict):
+                settings[name] = TransitionConfig(**settings[name])
+        except (ValueError, SyntaxError, TypeError):
+            parser.error(
+                f"--set {assignment!r}: VALUE must be a Python literal (transitions: a dict of its fields)"
+            )
     return settings

@@ -46,7 +46,12 @@ def test_guide_failures_sets_generator_fields_from_the_command_line():
     parser = argparse.ArgumentParser()
     settings = common.generator_settings(["retry_settings=()", "max_candidates = 12"], parser)
     assert settings == {"retry_settings": (), "max_candidates": 12}
-    for bad in ("no_such_field=1", "max_candidates", "lookahead=fast"):
+    from leas_jax.contacts.planner.config import TransitionConfig
+
+    checked = common.generator_settings(["transitions={}", "max_candidates=12"], parser)["transitions"]
+    assert checked == TransitionConfig()
+    assert common.generator_settings(["transitions={'min_knee': 0.2}"], parser)["transitions"].min_knee == 0.2
+    for bad in ("no_such_field=1", "max_candidates", "lookahead=fast", "transitions={'knee': 1}"):
         with pytest.raises(SystemExit):
             common.generator_settings([bad], parser)
     report = {"policy": "p", "terrain": "t", "spawns": "condition", "upper_bodies": ["half_sitting"]}

@@ -261,7 +261,8 @@ def register(subparsers) -> None:
         "--motion",
         action="store_true",
         help="also make a few of each scenario's LeaS and navigate plans that cover their guide into "
-        "whole-body motions and simulate them in MuJoCo (results.json's `motion`, table.md)",
+        "whole-body motions and simulate them in MuJoCo (results.json's `motion`, table.md); every "
+        "method's plans then have the transitions a motion needs checked as they are made",
     )
     parser.add_argument(
         "--motion-plans",

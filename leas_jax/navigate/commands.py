@@ -7,8 +7,9 @@
 Progress goes to stderr, one line per step; the summary to stdout. The plan file is the
 docs/design.md §6 format (`ContactPlan.save`), so `leas verify` and `leas show` read it.
 Exit code 0: the goal is reached; 1: it is not (the best partial plan is written when the
-generator verified any posture); 2: bad input. With `--motion`, a reached plan is also made
-into a whole-body motion and simulated in MuJoCo (`leas_jax.motion.execute`): one line gives
+generator verified any posture); 2: bad input. With `--motion`, the generator also checks each
+step's lift-off and landing as a motion takes them (`contacts.planner.transitions`), and a
+reached plan is made into a whole-body motion and simulated in MuJoCo (`leas_jax.motion.execute`): one line gives
 the verdict (fallen or not, worst landing error, slip, torque ratio) or the phase that cannot
 be made and why; the exit code is 1 unless the motion is made and executes (as `leas motion`
 and `leas simulate` say). Module-level imports stay light (no JAX):
@@ -170,8 +171,9 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--motion",
         metavar="MOTION.npz",
-        help="make the reached plan's whole-body motion, simulate it in MuJoCo and write it here "
-        "(exit 1 when it cannot be made or does not execute)",
+        help="plan with the transitions a motion needs checked (lift-offs, landings), make the reached "
+        "plan's whole-body motion, simulate it in MuJoCo and write it here (exit 1 when it cannot be made "
+        "or does not execute)",
     )
     parser.add_argument("--degrees", action="store_true", help="YAW of --start is in degrees")
     parser.add_argument("--speed", type=float, default=0.0, help="initial speed along the heading (m/s)")

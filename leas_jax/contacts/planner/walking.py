@@ -10,7 +10,9 @@ guide. The other foot is tried if the most lagging one cannot step; steps that b
 their foot nearer its target (`min_step_gain`) are tried on both feet before a step that
 does not; where neither foot can step toward its `lookahead` target, both try toward
 their places under the planning pose (`fallback_lookahead`). At most
-`max_steps_per_pose` steps per planning pose (docs/design.md §6).
+`max_steps_per_pose` steps per planning pose (docs/design.md §6). With
+`GeneratorConfig.transitions`, a single support must also lift its foot off and each foothold
+take its landing as a whole-body motion takes them (`transitions.TransitionCheck`).
 
 Host-only, not jittable.
 """

@@ -12,9 +12,9 @@ import sys
 import numpy as np
 
 from leas_jax.contacts.plan import ContactPlan
+from leas_jax.contacts.robot.clearance import BodyClearance
 from leas_jax.contacts.robot.model import load_talos
 from leas_jax.motion import motion
-from leas_jax.motion.clearance import BodyClearance
 from leas_jax.terrain import loads_terrain
 
 if __name__ == "__main__":

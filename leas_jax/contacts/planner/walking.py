@@ -209,13 +209,15 @@ class Walking:
                 if not self.comfortable(pose, contacts[1:]):
                     continue
                 double = self.projection.posture(pose, index, contacts)
-                if double is not None and self.transitions is not None:
-                    if self.transitions.landing(single, side, (pos, rot), double) is not None:
-                        self.projection.count_rejection("transition: landing")
-                        continue
-                if double is not None:
-                    feet[side] = (pos, rot)
-                    return double, held_back
+                if double is None:
+                    continue
+                if self.transitions is not None and self.transitions.landing(
+                    single, side, (pos, rot), double
+                ):
+                    self.projection.count_rejection("transition: landing")
+                    continue
+                feet[side] = (pos, rot)
+                return double, held_back
         if tried == 0:
             self.projection.count_rejection("no foothold")
         return None, held_back

@@ -96,6 +96,13 @@ class MotionConfig:
     # minimum-jerk move stays under this, m/s^2 (on eval_stairs a 0.11 m move in 0.6 s,
     # 1.8 m/s^2, took the equilibrium robustness below 0).
     single_support_acceleration: float = 0.5
+    # A single support that still fails the equilibrium check with its CoM kept inside the
+    # stance sole (`root_shift`) is made once more with its CoM's acceleration under this,
+    # m/s^2: a CoM 3 cm inside the sole's edge leaves the zero-moment point inside it up to
+    # 3 cm * g / h = 0.33 m/s^2 (h = 0.90 m); on talos_stairs15_0's landing 25 -> 26 a
+    # 0.41 m/s^2 swing of the CoM took the robustness to -0.68
+    # (docs/results/2026-12-07-motion-arm-detours). 0: not made again.
+    slowed_acceleration: float = 0.25
     # Sole corners on the swing path may sink this far below the terrain surface, m (the
     # 5 mm contact tolerance of docs/design.md §6 check 1), except in the first and last
     # `contact_zone` of height above the contact plane, where the sole leaves or meets it.

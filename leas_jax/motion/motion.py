@@ -127,6 +127,26 @@ UPPER_BODY_SPLIT = 0.5
 # Where no span of a shift clears their way, the change moves at most this many postures
 # earlier or later (`tucked_arms`).
 ARM_CHANGE_REACH = 4
+# Detours of an arm whose samples in a phase meet the terrain or the body (`detoured_phase`):
+# offsets, rad, of the shoulder pitch (arm_X_1), the shoulder roll outwards (arm_X_2) and the
+# elbow (arm_X_4, negative bends it), reached at mid-phase and gone at both ends
+# (`detour_profile`), so every key posture stays the plan's. Tried in this order, the fewest
+# joints and the smallest offsets first, the first whose phase collides nowhere kept. The key
+# postures hold a gripper as near as 5 mm to a debris tile or a stair's wall, and the root's
+# travel in a shift sweeps it in: on slalom_debris_0 a 0.4 rad pitch back clears the
+# fingertip; on talos_stairs15_0 the thigh meets a held-in gripper unless the shoulder rolls
+# out 0.3 rad and the elbow bends 0.5, and where the arms come out beside the stair's wall a
+# 0.6 rad roll is needed (docs/results/2026-12-07-motion-arm-detours).
+ARM_DETOURS = tuple(
+    sorted(
+        (
+            d
+            for d in itertools.product((0.0, -0.4, 0.4, -0.8, 0.8), (0.0, 0.3, 0.6), (0.0, -0.5, -1.0))
+            if any(d)
+        ),
+        key=lambda d: (sum(1 for x in d if x), sum(abs(x) for x in d)),
+    )
+)
 
 
 class MotionError(LeasError):
@@ -341,6 +361,8 @@ class _PhaseSpec:
             from upper0's to upper1's (`upper_body_window`).
         swing_offset: m, the swing sole's path bulges this far away from the stance sole
             (`swing_feet`); swing_held: the bulge held out while the legs pass, not a bump.
+        upper_detour: [39] offsets of the upper-body joints reached at mid-phase
+            (`detour_profile`; zero elsewhere), or None: none (`detoured_phase`).
     """
 
     kind: str
@@ -360,6 +382,7 @@ class _PhaseSpec:
     upper_window: tuple = (0.0, 1.0)
     swing_offset: float = 0.0
     swing_held: bool = False
+    upper_detour: np.ndarray | None = None
 
 
 def _homogeneous(placement: np.ndarray) -> np.ndarray:
@@ -1351,6 +1374,40 @@ def away_from_stance(spec: _PhaseSpec) -> np.ndarray:
     return square if square @ outward >= 0.0 else -square
 
 
+def detour_profile(fractions: np.ndarray) -> np.ndarray:
+    """Weight [N] of an arm detour at normalised times fractions [N] in [0, 1]: sin^2(pi t),
+    0 with zero speed at both ends, 1 at mid-phase."""
+    return np.sin(np.pi * np.asarray(fractions)) ** 2
+
+
+def colliding_arms(messages) -> set[int]:
+    """Sides (0 left, 1 right) whose arm or gripper a phase's collision messages name
+    (`BodyClearance.collisions`: "A collides with B"; None entries: nothing collides)."""
+    sides = set()
+    for message in messages:
+        for name in (message or "").split(" collides with "):
+            if name.startswith(("arm_", "gripper_")):
+                sides.add(0 if name.split("_")[1] == "left" else 1)
+    return sides
+
+
+def arm_detour(model, spec: _PhaseSpec, sides: set, detour: tuple) -> np.ndarray:
+    """Upper-body offsets [39] of one ARM_DETOURS entry (shoulder pitch, roll outwards, elbow;
+    rad) on the arms of `sides`, each cut so that the phase's upper body (straight from
+    spec.upper0's to spec.upper1's) stays LIMIT_MARGIN inside its joint limits."""
+    offsets = np.zeros(model.nq)
+    for side in sides:
+        name = SIDES[side]
+        outwards = 1.0 if side == 0 else -1.0  # the right arm's roll mirrors the left's
+        for joint, value in zip((1, 2, 4), (detour[0], outwards * detour[1], detour[2])):
+            index = model.joints[model.getJointId(f"arm_{name}_{joint}_joint")].idx_q
+            ends = (spec.upper0[index], spec.upper1[index])
+            lowest = model.lowerPositionLimit[index] + LIMIT_MARGIN - min(ends)
+            highest = model.upperPositionLimit[index] - LIMIT_MARGIN - max(ends)
+            offsets[index] = min(max(value, min(lowest, 0.0)), max(highest, 0.0))
+    return offsets
+
+
 def phase_references(spec: _PhaseSpec, dt: float):
     """Task references of a phase's samples 1..n (sample 0 is the previous phase's end).
 
@@ -1367,6 +1424,8 @@ def phase_references(spec: _PhaseSpec, dt: float):
     coms = lerp(spec.com0, spec.com1, s) if spec.coms is None else spec.coms
     rots = slerp(spec.rot0, spec.rot1, turn_scaling(spec, fractions))
     uppers = lerp(spec.upper0, spec.upper1, window(fractions, spec.upper_window))
+    if spec.upper_detour is not None:
+        uppers = uppers + detour_profile(fractions)[:, None] * spec.upper_detour[None]
     feet = swing_feet(spec, fractions)
     return [Targets(feet[i], coms[i], rots[i], uppers[i]) for i in range(spec.samples)]
 
@@ -1403,7 +1462,8 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
 
     A single support that fails the equilibrium check is made again once with its CoM kept
     inside the stance sole (`shifted_support`, the shifts from none up; where it cannot,
-    as before); every other phase is made as before.
+    as before), and one that still fails once more with its CoM moving slower
+    (`MotionConfig.slowed_acceleration`); every other phase is made as before.
 
     Args:
         plan: the contact plan (at least 2 postures).
@@ -1437,24 +1497,35 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
         plan = dataclasses.replace(plan, q=keys)
         frames = [posture_frames(talos, q) for q in plan.q]
     balanced = set()  # segments k whose single support keeps its CoM inside the stance sole
-    segments = {}  # (k, balanced): its phase specs, kept across the remake
+    slowed = set()  # segments k whose single support also moves its CoM slower (`slowed_acceleration`)
+    slow_config = dataclasses.replace(config, single_support_acceleration=config.slowed_acceleration)
+    segments = {}  # (k, balanced, slowed): its phase specs, kept across the remakes
     while True:
         specs = []
         for k in range(len(plan) - 1):
-            key = (k, k in balanced)
+            key = (k, k in balanced, k in slowed)
             if key not in segments:
-                segments[key] = _segment_phases(plan, k, frames, terrain, config, talos, key[1], clearance)
+                segments[key] = _segment_phases(
+                    plan, k, frames, terrain, slow_config if key[2] else config, talos, key[1], clearance
+                )
             specs.extend(segments[key])
-        motion = _sampled_motion(plan, original, moved, specs, frames, terrain, config, talos, ik)
-        failures = check_motion(motion, config, clearance)
+        motion, collided = _sampled_motion(
+            plan, original, moved, specs, frames, terrain, config, talos, ik, clearance
+        )
+        failures = check_motion(motion, config, clearance, collided)
         unbalanced = {
             motion.phases[index].postures[0]
             for _, index, name, _ in failures
             if name == "equilibrium" and motion.phases[index].single_support
         }
-        if balanced or not unbalanced or config.root_shift <= 0.0:
+        if not unbalanced or slowed:
             break
-        balanced = unbalanced
+        if not balanced and config.root_shift > 0.0:
+            balanced = unbalanced
+        elif config.slowed_acceleration > 0.0:
+            balanced, slowed = balanced | unbalanced, unbalanced
+        else:
+            break
     if check and failures:
         sample, index, name, message = failures[0]
         raise MotionError(
@@ -1465,15 +1536,19 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     return motion
 
 
-def _sampled_motion(plan, original, moved, specs, frames, terrain, config: MotionConfig, talos, ik) -> Motion:
+def _sampled_motion(
+    plan, original, moved, specs, frames, terrain, config: MotionConfig, talos, ik, clearance
+) -> tuple[Motion, list]:
     """The Motion of phase specs along plan (its key postures, centred) by whole-body IK,
-    sample by sample, with velocities, accelerations, torques and wrenches; original: the plan
-    as given (`Motion.plan_q`), moved: the key postures reached otherwise (`Motion.moved_keys`). Raises MotionError naming the phase whose swing meets the
-    terrain, whose IK fails or ends off the next key posture."""
-    from leas_jax.motion.wbik import IKError
-
+    sample by sample, with velocities, accelerations, torques and wrenches, and what collides
+    at each sample (`BodyClearance.collisions` of clearance, a message or None), a phase whose
+    arms collide made again with a detour (`detoured_phase`); original: the plan as given
+    (`Motion.plan_q`), moved: the key postures reached otherwise (`Motion.moved_keys`). Raises
+    MotionError naming the phase whose swing meets the terrain, whose IK fails or ends off the
+    next key posture."""
     q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
     contact_samples.append(_contacts(plan, 0))
+    collided = [clearance.collisions(plan.q[0])]
     phases, key_index = [], [0]
     for spec in specs:
         start = len(q_samples) - 1
@@ -1482,17 +1557,20 @@ def _sampled_motion(plan, original, moved, specs, frames, terrain, config: Motio
         reason = _swing_clearance(terrain, spec, references, config)
         if reason:
             raise MotionError(f"{phase.describe(config.dt)}: {reason}")
+        configurations = _phase_configurations(ik, q_samples[-1], references, phase, config.dt)
+        messages = [clearance.collisions(q) for q in configurations]
+        sides = colliding_arms(messages)
+        if sides:
+            spec, references, configurations, messages = detoured_phase(
+                spec, phase, sides, q_samples[-1], talos, ik, clearance, config.dt
+            ) or (spec, references, configurations, messages)
         in_contact = np.array([side != spec.swing for side in (0, 1)])
-        q = q_samples[-1]
-        for i, ref in enumerate(references):
-            try:
-                q = ik.solve(q, ref)
-            except IKError as exc:
-                raise MotionError(f"{phase.describe(config.dt)}: sample {i + 1}: {exc}") from None
+        for q, ref, message in zip(configurations, references, messages):
             q_samples.append(q)
             feet_samples.append(ref.feet)
             com_samples.append(ref.com)
             contact_samples.append(in_contact)
+            collided.append(message)
         last = spec.postures[1]
         if _ends_segment(specs, spec):
             gap = _configuration_gap(talos.model, q_samples[-1], plan.q[last])
@@ -1502,6 +1580,7 @@ def _sampled_motion(plan, original, moved, specs, frames, terrain, config: Motio
                 )
             q_samples[-1] = plan.q[last].copy()
             contact_samples[-1] = _contacts(plan, last)
+            collided[-1] = clearance.collisions(q_samples[-1])
             key_index.append(len(q_samples) - 1)
         phases.append(phase)
     q = np.array(q_samples)
@@ -1526,7 +1605,50 @@ def _sampled_motion(plan, original, moved, specs, frames, terrain, config: Motio
         moved_keys=np.array(moved, dtype=np.int64),
         terrain=plan.terrain,
         dt=config.dt,
-    )
+    ), collided
+
+
+def _phase_configurations(ik, q0: np.ndarray, references, phase: Phase, dt: float) -> np.ndarray:
+    """Configurations [n, 39] of a phase's samples 1..n by whole-body IK from q0 [39], each
+    sample from the last; MotionError naming the phase and sample where the IK fails."""
+    from leas_jax.motion.wbik import IKError
+
+    configurations, q = [], q0
+    for i, ref in enumerate(references):
+        try:
+            q = ik.solve(q, ref)
+        except IKError as exc:
+            raise MotionError(f"{phase.describe(dt)}: sample {i + 1}: {exc}") from None
+        configurations.append(q)
+    return np.array(configurations)
+
+
+def detoured_phase(
+    spec: _PhaseSpec, phase: Phase, sides: set, q0: np.ndarray, talos, ik, clearance, dt: float
+):
+    """The first ARM_DETOURS entry (on the arms of `sides`, `arm_detour`) whose phase collides
+    nowhere: (spec, references, configurations [n, 39], collision messages [n]) of it, or None
+    where none does. A detour is left at its first colliding sample or IK failure."""
+    from leas_jax.motion.wbik import IKError
+
+    for detour in ARM_DETOURS:
+        offsets = arm_detour(talos.model, spec, sides, detour)
+        if not offsets.any():
+            continue
+        trial = dataclasses.replace(spec, upper_detour=offsets)
+        references = phase_references(trial, dt)
+        configurations, q = [], q0
+        for ref in references:
+            try:
+                q = ik.solve(q, ref)
+            except IKError:
+                break
+            if clearance.collisions(q):
+                break
+            configurations.append(q)
+        if len(configurations) == len(references):
+            return trial, references, np.array(configurations), [None] * len(references)
+    return None
 
 
 def _ends_segment(specs: list, spec: _PhaseSpec) -> bool:
@@ -1572,7 +1694,7 @@ def _torques(talos, q, v, a, contact) -> tuple[np.ndarray, np.ndarray]:
 
 
 def check_motion(
-    motion: Motion, config: MotionConfig = MotionConfig(), clearance=None
+    motion: Motion, config: MotionConfig = MotionConfig(), clearance=None, collided=None
 ) -> list[tuple[int, int, str, str]]:
     """Samples of a motion that fail a check.
 
@@ -1583,7 +1705,8 @@ def check_motion(
     equal to a fresh inverse dynamics of (q, v, a) (so edited torques are caught too); no
     collision with the terrain or between the legs and the body, as the verifier checks key
     postures (`clearance.BodyClearance.collisions`; clearance: one built on the motion's
-    terrain, else made here).
+    terrain, else made here; collided: its messages per sample where already found, [N] of
+    str or None, else found here).
 
     Returns:
         list of (sample index, phase index, check name, message), in time order per check.
@@ -1631,7 +1754,7 @@ def check_motion(
         value = _robustness(solver, feet, motion.com[sample], acceleration[sample])
         if not value >= config.min_robustness:
             fail(sample, "equilibrium", f"robustness {value:.3g} < {config.min_robustness}")
-        collision = clearance.collisions(motion.q[sample])
+        collision = clearance.collisions(motion.q[sample]) if collided is None else collided[sample]
         if collision:
             fail(sample, "collisions", collision)
     failures.sort(key=lambda item: item[0])

@@ -7,7 +7,17 @@ from motion_helpers import straight_plan
 from leas_jax.contacts.plan import ContactPlan
 from leas_jax.contacts.robot.model import load_talos
 from leas_jax.motion.config import MotionConfig
-from leas_jax.motion.motion import Motion, MotionError, check_motion, make_motion, posture_frames
+from leas_jax.motion.motion import (
+    ARM_DETOURS,
+    Motion,
+    MotionError,
+    arm_detour,
+    check_motion,
+    colliding_arms,
+    detour_profile,
+    make_motion,
+    posture_frames,
+)
 
 
 @pytest.fixture(scope="module")
@@ -135,6 +145,71 @@ def test_save_load_round_trip(motion, tmp_path):
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
     with pytest.raises(MotionError, match="not a readable motion file"):
         Motion.load(tmp_path / "bad.npz")
+
+
+def test_arm_detours_are_smooth_mirrored_and_within_limits(plan):
+    profile = detour_profile(np.linspace(0.0, 1.0, 101))
+    assert profile[0] == 0.0 and abs(profile[-1]) < 1e-30 and profile[50] == pytest.approx(1.0)
+    assert colliding_arms(["leg_left_3_link_0 collides with gripper_left_motor_single_link_0"]) == {0}
+    assert colliding_arms([None, "gripper_right_fingertip_2_link_0 collides with terrain box 1"]) == {1}
+    assert colliding_arms(["leg_left_4_link_0 collides with leg_right_6_link_0", None]) == set()
+    model = load_talos().model
+    spec = _Spec(plan.q[0], plan.q[0])
+    index = {name: model.joints[model.getJointId(name)].idx_q for name in model.names[1:]}
+    both = arm_detour(model, spec, {0, 1}, (0.4, 0.3, -0.5))
+    moved = np.flatnonzero(both)
+    assert sorted(moved) == sorted(index[f"arm_{side}_{j}_joint"] for side in ("left", "right") for j in (1, 2, 4))
+    assert both[index["arm_left_2_joint"]] == -both[index["arm_right_2_joint"]] == pytest.approx(0.3)
+    right = arm_detour(model, spec, {1}, (0.4, 0.3, -0.5))
+    assert not right[index["arm_left_1_joint"]] and right[index["arm_right_1_joint"]] == pytest.approx(0.4)
+    # an offset past a joint's limit is cut LIMIT_MARGIN inside it
+    huge = arm_detour(model, spec, {0}, (0.0, 0.0, -9.0))
+    elbow = index["arm_left_4_joint"]
+    assert plan.q[0][elbow] + huge[elbow] == pytest.approx(model.lowerPositionLimit[elbow] + 0.03)
+    assert len(set(ARM_DETOURS)) == len(ARM_DETOURS) and (0.0, 0.0, 0.0) not in ARM_DETOURS
+
+
+def test_an_arm_swept_into_an_obstacle_detours_round_it(plan, motion):
+    """A 3 cm cube where a gripper passes in the middle of a shift, clear of every key posture:
+    the motion's arm goes round it, every key posture stays the plan's."""
+    import dataclasses
+
+    from leas_jax.contacts.robot.clearance import BodyClearance
+    from leas_jax.terrain import loads_terrain
+
+    talos = load_talos()
+    frame = talos.model.getFrameId("gripper_right_fingertip_2_link")
+
+    def fingertip(q):
+        import pinocchio as pin
+
+        pin.framesForwardKinematics(talos.model, talos.data, q)
+        return talos.data.oMf[frame].translation.copy()
+
+    def sweep(phase):
+        middle = (phase.start + phase.stop) // 2
+        ends = min(np.linalg.norm(fingertip(motion.q[i]) - fingertip(motion.q[middle])) for i in motion.key_index)
+        return ends, middle
+
+    ends, middle = max(sweep(p) for p in motion.phases if p.kind == "shift")
+    assert ends > 0.05  # the gripper passes 5 cm or more from where any key posture holds it
+    x, y, z = fingertip(motion.q[middle])
+    box = f"\n[[box]]\ncenter = [{x}, {y}, {z}]\nsize = [0.03, 0.03, 0.03]\n"
+    blocked = dataclasses.replace(plan, terrain=plan.terrain.replace("\n[scenario]", box + "\n[scenario]", 1))
+    clearance = BodyClearance(talos, loads_terrain(blocked.terrain))
+    assert colliding_arms([clearance.collisions(motion.q[middle])]) == {1}
+    assert not any(clearance.collisions(q) for q in plan.q)
+    detoured = make_motion(blocked)  # raises where a sample collides
+    np.testing.assert_array_equal(detoured.q[detoured.key_index], plan.q)
+    assert not any(clearance.collisions(q) for q in detoured.q[::5])
+    assert np.abs(detoured.q[:, 7:19] - motion.q[:, 7:19]).max() < 0.05  # the legs as before, or near
+
+
+def _Spec(upper0, upper1):
+    """The two upper bodies of a phase, as `arm_detour` reads them."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(upper0=upper0, upper1=upper1)
 
 
 def _replace(motion, **changes):

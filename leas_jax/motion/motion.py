@@ -1557,6 +1557,7 @@ def _sampled_motion(
         reason = _swing_clearance(terrain, spec, references, config)
         if reason:
             raise MotionError(f"{phase.describe(config.dt)}: {reason}")
+        ends_segment = _ends_segment(specs, spec)
         configurations = _phase_configurations(ik, q_samples[-1], references, phase, config.dt)
         messages = [clearance.collisions(q) for q in configurations]
         sides = colliding_arms(messages)
@@ -1572,7 +1573,7 @@ def _sampled_motion(
             contact_samples.append(in_contact)
             collided.append(message)
         last = spec.postures[1]
-        if _ends_segment(specs, spec):
+        if ends_segment:
             gap = _configuration_gap(talos.model, q_samples[-1], plan.q[last])
             if gap > KEY_POSTURE_TOL:
                 raise MotionError(

@@ -158,7 +158,9 @@ def test_arm_detours_are_smooth_mirrored_and_within_limits(plan):
     index = {name: model.joints[model.getJointId(name)].idx_q for name in model.names[1:]}
     both = arm_detour(model, spec, {0, 1}, (0.4, 0.3, -0.5))
     moved = np.flatnonzero(both)
-    assert sorted(moved) == sorted(index[f"arm_{side}_{j}_joint"] for side in ("left", "right") for j in (1, 2, 4))
+    assert sorted(moved) == sorted(
+        index[f"arm_{side}_{j}_joint"] for side in ("left", "right") for j in (1, 2, 4)
+    )
     assert both[index["arm_left_2_joint"]] == -both[index["arm_right_2_joint"]] == pytest.approx(0.3)
     right = arm_detour(model, spec, {1}, (0.4, 0.3, -0.5))
     assert not right[index["arm_left_1_joint"]] and right[index["arm_right_1_joint"]] == pytest.approx(0.4)
@@ -188,7 +190,9 @@ def test_an_arm_swept_into_an_obstacle_detours_round_it(plan, motion):
 
     def sweep(phase):
         middle = (phase.start + phase.stop) // 2
-        ends = min(np.linalg.norm(fingertip(motion.q[i]) - fingertip(motion.q[middle])) for i in motion.key_index)
+        ends = min(
+            np.linalg.norm(fingertip(motion.q[i]) - fingertip(motion.q[middle])) for i in motion.key_index
+        )
         return ends, middle
 
     ends, middle = max(sweep(p) for p in motion.phases if p.kind == "shift")

@@ -344,13 +344,9 @@ def run(args) -> dict:
 
 def combine(args) -> dict:
     """Merge the scenarios of the variants named by --combine (later ones win) into --variant's
-    JSON and markdown; the first variant's settings are kept, the others' noted. A name that
-    ends in .json is that file (another folder's run), relative to the repository."""
+    JSON and markdown; the first variant's settings are kept, the others' noted."""
     out = Path(args.out)
-    reports = [
-        json.loads((ROOT / v if v.endswith(".json") else out / f"motion_execution_{v}.json").read_text())
-        for v in args.combine.split(",")
-    ]
+    reports = [json.loads((out / f"motion_execution_{v}.json").read_text()) for v in args.combine.split(",")]
     report = dict(reports[0], variant=args.variant, combined_from=args.combine.split(","))
     report["scenarios"] = {}
     for part in reports:
@@ -515,8 +511,7 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--combine",
         default=None,
-        help="comma-separated variants whose JSON files in --out (or paths ending in .json) are merged "
-        "into --variant's (nothing run)",
+        help="comma-separated variants whose JSON files in --out are merged into --variant's (nothing run)",
     )
     parser.add_argument("--motion-config", default="{}", help="JSON of MotionConfig overrides")
     parser.add_argument("--simulation-config", default="{}", help="JSON of SimulationConfig overrides")

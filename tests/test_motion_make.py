@@ -12,11 +12,14 @@ from leas_jax.motion.motion import (
     Motion,
     MotionError,
     arm_detour,
+    centred_postures,
     check_motion,
     colliding_arms,
     detour_profile,
     make_motion,
+    off_centre_segments,
     posture_frames,
+    pressure_margins,
 )
 
 
@@ -207,6 +210,59 @@ def test_an_arm_swept_into_an_obstacle_detours_round_it(plan, motion):
     np.testing.assert_array_equal(detoured.q[detoured.key_index], plan.q)
     assert not any(clearance.collisions(q) for q in detoured.q[::5])
     assert np.abs(detoured.q[:, 7:19] - motion.q[:, 7:19]).max() < 0.05  # the legs as before, or near
+
+
+def test_centre_of_pressure_is_checked_and_remade_slower(plan, motion):
+    margins = pressure_margins(motion)
+    single = motion.contact.sum(axis=1) == 1
+    assert np.isnan(margins[~single]).all() and (margins[single] >= 0.0).all()
+    assert off_centre_segments(motion, -1.0) == set()
+    steps = {p.postures[0] for p in motion.phases if p.single_support}
+    assert off_centre_segments(motion, 1.0) == steps
+    # the stance sole's centre of pressure 5 cm past its toe at one sample
+    sample = int(np.flatnonzero(single)[40])
+    wrenches = motion.wrenches.copy()
+    side = int(np.argmax(motion.contact[sample]))
+    wrenches[sample, side, 4] = -0.15 * wrenches[sample, side, 2]
+    failures = check_motion(_replace(motion, wrenches=wrenches))
+    assert [(s, name) for s, _, name, _ in failures] == [(sample, "centre of pressure")]
+    # a margin over some single supports' own: those are made again, then slower
+    tightest = sorted(np.nanmin(margins[p.start + 1 : p.stop + 1]) for p in motion.phases if p.single_support)
+    config = MotionConfig(pressure_margin=float(tightest[1]))
+    remade = make_motion(plan, config, check=False)
+    np.testing.assert_array_equal(remade.q[remade.key_index], plan.q)
+    lengths = {p.postures: p.stop - p.start for p in motion.phases if p.single_support}
+    longer = [p for p in remade.phases if p.single_support and p.stop - p.start > 1.5 * lengths[p.postures]]
+    assert longer and {p.postures[0] for p in longer} <= off_centre_segments(motion, config.pressure_margin)
+
+
+def test_one_foot_postures_near_their_sole_edge_are_centred(plan):
+    from leas_jax.motion.motion import sole_corners, support_margin
+    from leas_jax.motion.wbik import WholeBodyIK
+
+    talos = load_talos()
+    config = MotionConfig()
+    ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
+    frames = [posture_frames(talos, q) for q in plan.q]
+    on = ~np.isnan(plan.feet[:, :, 0])
+    single = [k for k in range(1, len(plan)) if on[k].sum() == 1]
+    margins = {k: support_margin(sole_corners(frames[k][0], on[k]), frames[k][1][:2]) for k in single}
+    wanted = float(np.median(list(margins.values())))  # half the one-foot postures are nearer their edge
+    q, moved = centred_postures(talos, plan, frames, 0.0, ik, single_margin=wanted)
+    assert moved and set(moved) == {k for k in single if margins[k] < wanted}
+    for k in range(len(plan)):
+        feet, com, _ = posture_frames(talos, q[k])
+        np.testing.assert_allclose(feet[on[k]], frames[k][0][on[k]], atol=1e-6)  # soles kept
+        if k in moved:
+            assert support_margin(sole_corners(feet, on[k]), com[:2]) >= wanted - 1e-6
+        else:
+            np.testing.assert_array_equal(q[k], plan.q[k])
+
+    class Blocked:  # every configuration collides
+        def collisions(self, q):
+            return "arm_left_1_link_0 collides with a test wall"
+
+    assert centred_postures(talos, plan, frames, 0.0, ik, wanted, Blocked())[1] == []
 
 
 def _Spec(upper0, upper1):

@@ -131,7 +131,7 @@ def test_a_balanced_single_support_keeps_its_com_inside_where_the_held_root_lean
 def test_a_single_support_failing_its_equilibrium_check_is_made_again_balanced(monkeypatch):
     """make_motion makes a single support whose samples fail the equilibrium check once more
     with `balanced` (only that segment), and keeps the second motion; with root_shift 0 it
-    does not, and the failure is reported."""
+    makes it slower instead, and with neither it does not, and the failure is reported."""
     plan = straight_plan(0.3)
     segments, checks = [], []
     real_segment, real_check = motion._segment_phases, motion.check_motion
@@ -140,8 +140,8 @@ def test_a_single_support_failing_its_equilibrium_check_is_made_again_balanced(m
         segments.append((k, balanced))
         return real_segment(plan, k, frames, terrain, config, talos, balanced, clearance)
 
-    def check(made, config, clearance=None):
-        failures = real_check(made, config, clearance)
+    def check(made, config, clearance=None, collided=None):
+        failures = real_check(made, config, clearance, collided)
         if not checks:  # the first motion: its first single support said to tip over
             index = next(i for i, phase in enumerate(made.phases) if phase.single_support)
             failures.append((made.phases[index].start + 1, index, "equilibrium", "robustness -1 < 0.0"))
@@ -156,8 +156,16 @@ def test_a_single_support_failing_its_equilibrium_check_is_made_again_balanced(m
     assert [k for k, balanced in segments if balanced] == [first]
     assert len(segments) == len(plan)  # every segment once, the remade one twice
     segments.clear(), checks.clear()
-    made = motion.make_motion(plan, dataclasses.replace(MotionConfig(), root_shift=0.0), check=False)
+    unmoved = dataclasses.replace(MotionConfig(), root_shift=0.0, slowed_duration=0.0)
+    made = motion.make_motion(plan, unmoved, check=False)
     assert len(checks) == 1 and [f[2] for f in made.failures] == ["equilibrium"]
+    # without root shifts, the segment is made again slower, not balanced
+    segments.clear(), checks.clear()
+    made = motion.make_motion(plan, dataclasses.replace(MotionConfig(), root_shift=0.0), check=False)
+    assert len(checks) == 2 and made.failures == [] and not any(balanced for _, balanced in segments)
+    slow = [p for p in made.phases if p.single_support and p.postures[0] == first]
+    fast = [p for p in checks[0].phases if p.single_support and p.postures[0] == first]
+    assert sum(p.stop - p.start for p in slow) >= 1.9 * sum(p.stop - p.start for p in fast)
 
 
 def test_a_long_profile_whose_fewer_samples_leave_no_room_is_solved_at_every_sample():

@@ -69,6 +69,13 @@ class MotionConfig:
     # 0.10 m horizontally, every sample of 10 of them reaches with the CoM 2.8-6.5 cm inside.
     # 0: those phases fail as before, and no phase is made again.
     root_shift: float = 0.10
+    # The same margin holds the one-foot key postures (`motion.centred_postures`): one whose
+    # CoM is less than this far inside its stance sole is reached with its CoM moved inside,
+    # its soles, root orientation and upper body kept, where that stays within the joint
+    # limits and collides nowhere. The contact generator's one-foot postures need only be in
+    # equilibrium: rubbles_stairs_3_1's 239 holds its CoM 5 mm from the sole's side edge,
+    # and Talos rolled over that edge and fell there however slowly the swing moved
+    # (docs/results/2026-12-07-motion-arm-detours).
     single_support_margin: float = 0.03
     # Single-support configurations (held, profiled or shifted root) keep every geometry of
     # Talos but the feet this far from the terrain, m, or as far as the plan's one-foot
@@ -96,13 +103,26 @@ class MotionConfig:
     # minimum-jerk move stays under this, m/s^2 (on eval_stairs a 0.11 m move in 0.6 s,
     # 1.8 m/s^2, took the equilibrium robustness below 0).
     single_support_acceleration: float = 0.5
-    # A single support that still fails the equilibrium check with its CoM kept inside the
-    # stance sole (`root_shift`) is made once more with its CoM's acceleration under this,
-    # m/s^2: a CoM 3 cm inside the sole's edge leaves the zero-moment point inside it up to
-    # 3 cm * g / h = 0.33 m/s^2 (h = 0.90 m); on talos_stairs15_0's landing 25 -> 26 a
-    # 0.41 m/s^2 swing of the CoM took the robustness to -0.68
-    # (docs/results/2026-12-07-motion-arm-detours). 0: not made again.
+    # The stance sole's centre of pressure in single support, from the motion's own inverse
+    # dynamics (`Motion.wrenches`: the CoM's acceleration and the swing leg's angular momentum,
+    # which the equilibrium check leaves out), must lie on the sole (`check_motion`, "centre
+    # of pressure"), and a single support that keeps it less than this far inside the sole's
+    # edges, m, is made again as one that fails the equilibrium check is. MuJoCo tracks the
+    # CoM within 1-1.5 cm; the plans' landings took it 1.8 cm past a sole's side edge on
+    # rubbles_stairs_3_1 and to its toe on darpa_0, where Talos rolled over the edge, slipped
+    # 1.1-1.4 cm and fell (docs/results/2026-12-07-motion-arm-detours).
+    pressure_margin: float = 0.02
+    # A single support that still fails the equilibrium check, or keeps its centre of pressure
+    # under `pressure_margin`, with its CoM kept inside the stance sole (`root_shift`) is made
+    # once more slower: its lift and landing last `slowed_duration` times as long and its CoM
+    # accelerates at most `slowed_acceleration`, m/s^2 (a CoM 3 cm inside the sole's edge
+    # leaves the zero-moment point inside it up to 3 cm * g / h = 0.33 m/s^2, h = 0.90 m; on
+    # talos_stairs15_0's landing 25 -> 26 a 0.41 m/s^2 swing of the CoM took the robustness to
+    # -0.68). On darpa_0 twice as long single supports kept every centre of pressure 1.4 cm
+    # inside its sole, against 0.4 mm outside (docs/results/2026-12-07-motion-arm-detours).
+    # slowed_duration 0: not made again.
     slowed_acceleration: float = 0.25
+    slowed_duration: float = 2.0
     # Sole corners on the swing path may sink this far below the terrain surface, m (the
     # 5 mm contact tolerance of docs/design.md §6 check 1), except in the first and last
     # `contact_zone` of height above the contact plane, where the sole leaves or meets it.

@@ -984,31 +984,40 @@ def centred_com(points: np.ndarray, com: np.ndarray, margin: float) -> np.ndarra
     return out
 
 
-def centred_postures(talos, plan: ContactPlan, frames, margin: float, ik) -> tuple[np.ndarray, list[int]]:
-    """The plan's postures [K, 39] with every double-support posture after the first whose CoM
-    is less than `margin` m inside its soles' support polygon moved (`centred_com`, whole-body
-    IK from the posture: soles, root orientation and upper body kept), and the moved indices.
+def centred_postures(
+    talos, plan: ContactPlan, frames, margin: float, ik, single_margin: float = 0.0, clearance=None
+) -> tuple[np.ndarray, list[int]]:
+    """The plan's postures [K, 39] with every posture after the first whose CoM is less than
+    `margin` m (double support) or `single_margin` m (single support) inside its soles'
+    support polygon moved (`centred_com`, whole-body IK from the posture: soles, root
+    orientation and upper body kept), and the moved indices.
 
-    A posture the IK cannot move (IKError) stays the plan's.
+    A posture the IK cannot move (IKError), or whose move takes a joint past its limits or
+    collides (`BodyClearance.collisions` of clearance, where given), stays the plan's.
     """
     from leas_jax.motion.wbik import IKError, Targets
 
     q = np.array(plan.q, dtype=np.float64)
+    lower, upper = talos.model.lowerPositionLimit[7:], talos.model.upperPositionLimit[7:]
     moved = []
-    if margin <= 0.0:
-        return q, moved
     for k in range(1, len(plan)):
         on = _contacts(plan, k)
-        if not on.all():
+        wanted = margin if on.all() else single_margin
+        if wanted <= 0.0:
             continue
         feet, com, rotation = frames[k]
-        target = centred_com(sole_corners(feet, on), com, margin)
+        target = centred_com(sole_corners(feet, on), com, wanted)
         if np.allclose(target, com):
             continue
         try:
-            q[k] = ik.solve(q[k], Targets(feet, target, rotation, q[k]))
+            centred = ik.solve(q[k], Targets(feet, target, rotation, q[k]))
         except IKError:
             continue
+        if ((centred[7:] < lower) | (centred[7:] > upper)).any():
+            continue
+        if clearance is not None and clearance.collisions(centred):
+            continue
+        q[k] = centred
         moved.append(k)
     return q, moved
 
@@ -1462,8 +1471,10 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
 
     A single support that fails the equilibrium check is made again once with its CoM kept
     inside the stance sole (`shifted_support`, the shifts from none up; where it cannot,
-    as before), and one that still fails once more with its CoM moving slower
-    (`MotionConfig.slowed_acceleration`); every other phase is made as before.
+    as before), and one that still fails once more slower (`MotionConfig.slowed_duration`);
+    a single support whose stance sole's centre of pressure comes within
+    `MotionConfig.pressure_margin` of its edges is made again the same way. Every other phase
+    is made as before (and not sampled again).
 
     Args:
         plan: the contact plan (at least 2 postures).
@@ -1490,16 +1501,24 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     clearance = BodyClearance(talos, terrain)
     original = plan
     frames = [posture_frames(talos, q) for q in plan.q]
-    keys, moved = centred_postures(talos, plan, frames, config.support_margin, ik)
+    keys, moved = centred_postures(
+        talos, plan, frames, config.support_margin, ik, config.single_support_margin, clearance
+    )
     keys, tucked = tucked_arms(keys, clearance)
     moved = sorted(set(moved) | set(tucked))
     if moved:
         plan = dataclasses.replace(plan, q=keys)
         frames = [posture_frames(talos, q) for q in plan.q]
     balanced = set()  # segments k whose single support keeps its CoM inside the stance sole
-    slowed = set()  # segments k whose single support also moves its CoM slower (`slowed_acceleration`)
-    slow_config = dataclasses.replace(config, single_support_acceleration=config.slowed_acceleration)
+    slowed = set()  # segments k whose single support is also slower (`MotionConfig.slowed_duration`)
+    slow_config = dataclasses.replace(
+        config,
+        single_support_acceleration=config.slowed_acceleration,
+        lift_duration=config.lift_duration * config.slowed_duration,
+        land_duration=config.land_duration * config.slowed_duration,
+    )
     segments = {}  # (k, balanced, slowed): its phase specs, kept across the remakes
+    solved = {}  # phases sampled, kept across the remakes (`_sampled_motion`)
     while True:
         specs = []
         for k in range(len(plan) - 1):
@@ -1510,20 +1529,22 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
                 )
             specs.extend(segments[key])
         motion, collided = _sampled_motion(
-            plan, original, moved, specs, frames, terrain, config, talos, ik, clearance
+            plan, original, moved, specs, frames, terrain, config, talos, ik, clearance, solved
         )
         failures = check_motion(motion, config, clearance, collided)
         unbalanced = {
             motion.phases[index].postures[0]
             for _, index, name, _ in failures
             if name == "equilibrium" and motion.phases[index].single_support
-        }
+        } | off_centre_segments(motion, config.pressure_margin)
         if not unbalanced or slowed:
             break
         if not balanced and config.root_shift > 0.0:
             balanced = unbalanced
-        elif config.slowed_acceleration > 0.0:
-            balanced, slowed = balanced | unbalanced, unbalanced
+        elif config.slowed_duration > 0.0:
+            slowed = unbalanced
+            if config.root_shift > 0.0:
+                balanced = balanced | unbalanced
         else:
             break
     if check and failures:
@@ -1537,7 +1558,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
 
 
 def _sampled_motion(
-    plan, original, moved, specs, frames, terrain, config: MotionConfig, talos, ik, clearance
+    plan, original, moved, specs, frames, terrain, config: MotionConfig, talos, ik, clearance, solved=None
 ) -> tuple[Motion, list]:
     """The Motion of phase specs along plan (its key postures, centred) by whole-body IK,
     sample by sample, with velocities, accelerations, torques and wrenches, and what collides
@@ -1545,7 +1566,9 @@ def _sampled_motion(
     arms collide made again with a detour (`detoured_phase`); original: the plan as given
     (`Motion.plan_q`), moved: the key postures reached otherwise (`Motion.moved_keys`). Raises
     MotionError naming the phase whose swing meets the terrain, whose IK fails or ends off the
-    next key posture."""
+    next key posture. solved: {id(spec): (first configuration [39], (spec, references,
+    configurations, messages))} of phases sampled before, reused where a phase starts from the
+    same configuration, and added to (None: nothing kept)."""
     q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
     contact_samples.append(_contacts(plan, 0))
     collided = [clearance.collisions(plan.q[0])]
@@ -1553,18 +1576,15 @@ def _sampled_motion(
     for spec in specs:
         start = len(q_samples) - 1
         phase = Phase(spec.kind, start, start + spec.samples, spec.postures, spec.swing)
-        references = phase_references(spec, config.dt)
-        reason = _swing_clearance(terrain, spec, references, config)
-        if reason:
-            raise MotionError(f"{phase.describe(config.dt)}: {reason}")
         ends_segment = _ends_segment(specs, spec)
-        configurations = _phase_configurations(ik, q_samples[-1], references, phase, config.dt)
-        messages = [clearance.collisions(q) for q in configurations]
-        sides = colliding_arms(messages)
-        if sides:
-            spec, references, configurations, messages = detoured_phase(
-                spec, phase, sides, q_samples[-1], talos, ik, clearance, config.dt
-            ) or (spec, references, configurations, messages)
+        earlier = (solved or {}).get(id(spec))
+        if earlier is not None and np.array_equal(earlier[0], q_samples[-1]):
+            sampled = earlier[1]
+        else:
+            sampled = _sampled_phase(spec, phase, q_samples[-1], terrain, config, talos, ik, clearance)
+            if solved is not None:
+                solved[id(spec)] = (q_samples[-1], sampled)
+        spec, references, configurations, messages = sampled
         in_contact = np.array([side != spec.swing for side in (0, 1)])
         for q, ref, message in zip(configurations, references, messages):
             q_samples.append(q)
@@ -1607,6 +1627,25 @@ def _sampled_motion(
         terrain=plan.terrain,
         dt=config.dt,
     ), collided
+
+
+def _sampled_phase(
+    spec: _PhaseSpec, phase: Phase, start_q: np.ndarray, terrain, config, talos, ik, clearance
+):
+    """(spec, references, configurations [n, 39], collision messages [n]) of a phase sampled
+    from start_q [39], its arms detoured where they collide (`detoured_phase`, whose spec it
+    then is); MotionError where its swing sole meets the terrain or its IK fails."""
+    references = phase_references(spec, config.dt)
+    reason = _swing_clearance(terrain, spec, references, config)
+    if reason:
+        raise MotionError(f"{phase.describe(config.dt)}: {reason}")
+    configurations = _phase_configurations(ik, start_q, references, phase, config.dt)
+    messages = [clearance.collisions(q) for q in configurations]
+    sampled = (spec, references, configurations, messages)
+    sides = colliding_arms(messages)
+    if sides:
+        return detoured_phase(spec, phase, sides, start_q, talos, ik, clearance, config.dt) or sampled
+    return sampled
 
 
 def _phase_configurations(ik, q0: np.ndarray, references, phase: Phase, dt: float) -> np.ndarray:
@@ -1702,7 +1741,10 @@ def check_motion(
     Checks at every sample: joint positions within the URDF's limits; joint velocities
     within `velocity_ratio` of the URDF's; static equilibrium with the CoM's acceleration
     (hpp-centroidal-dynamics robustness >= `min_robustness` over the sole corners in
-    contact); joint torques within `torque_ratio` of the effort limits; the stored torques
+    contact); in single support, the stance sole's centre of pressure from the motion's
+    wrenches on the sole (`pressure_margins` >= 0: the swing leg's angular momentum, which the
+    equilibrium check leaves out, moves it too); joint torques within `torque_ratio` of the
+    effort limits; the stored torques
     equal to a fresh inverse dynamics of (q, v, a) (so edited torques are caught too); no
     collision with the terrain or between the legs and the body, as the verifier checks key
     postures (`clearance.BodyClearance.collisions`; clearance: one built on the motion's
@@ -1758,8 +1800,37 @@ def check_motion(
         collision = clearance.collisions(motion.q[sample]) if collided is None else collided[sample]
         if collision:
             fail(sample, "collisions", collision)
+    margins = pressure_margins(motion)
+    for sample in np.flatnonzero(margins < 0.0):
+        fail(sample, "centre of pressure", f"{-margins[sample] * 100:.1f} cm outside the stance sole")
     failures.sort(key=lambda item: item[0])
     return failures
+
+
+def pressure_margins(motion: Motion) -> np.ndarray:
+    """[N] m: how far inside its sole rectangle (SOLE_LENGTH x SOLE_WIDTH, sole frame) the
+    stance sole's centre of pressure lies at each single-support sample, from the motion's
+    wrenches (negative: outside); NaN in double support and where the sole carries under 1 N."""
+    from leas_jax.contacts.robot.model import SOLE_LENGTH, SOLE_WIDTH
+
+    single = motion.contact.sum(axis=1) == 1
+    wrench = motion.wrenches[np.arange(len(motion.q)), np.argmax(motion.contact, axis=1)]  # [N, 6]
+    loaded = single & (wrench[:, 2] > 1.0)
+    force = np.where(loaded, wrench[:, 2], 1.0)
+    along, across = np.abs(wrench[:, 4] / force), np.abs(wrench[:, 3] / force)
+    return np.where(loaded, np.minimum(SOLE_LENGTH / 2 - along, SOLE_WIDTH / 2 - across), np.nan)
+
+
+def off_centre_segments(motion: Motion, margin: float) -> set[int]:
+    """Postures k whose single support (k to k + 1) holds a sample whose centre of pressure is
+    less than `margin`, m, inside the stance sole (`pressure_margins`)."""
+    margins = pressure_margins(motion)
+    return {
+        phase.postures[0]
+        for phase in motion.phases
+        if phase.single_support
+        and np.nanmin(margins[phase.start + 1 : phase.stop + 1], initial=np.inf) < margin
+    }
 
 
 def _robustness(solver, feet: np.ndarray, com: np.ndarray, acceleration: np.ndarray) -> float:

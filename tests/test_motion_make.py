@@ -246,7 +246,7 @@ def test_one_foot_postures_near_their_sole_edge_are_centred(plan):
     frames = [posture_frames(talos, q) for q in plan.q]
     on = ~np.isnan(plan.feet[:, :, 0])
     single = [k for k in range(1, len(plan)) if on[k].sum() == 1]
-    margins = {k: support_margin(sole_corners(frames[k][0], on[k]), frames[k][1][:2]) for k in single}
+    margins = _one_foot_margins(plan)
     wanted = float(np.median(list(margins.values())))  # half the one-foot postures are nearer their edge
     q, moved = centred_postures(talos, plan, frames, 0.0, ik, single_margin=wanted)
     assert moved and set(moved) == {k for k in single if margins[k] < wanted}
@@ -263,6 +263,43 @@ def test_one_foot_postures_near_their_sole_edge_are_centred(plan):
             return "arm_left_1_link_0 collides with a test wall"
 
     assert centred_postures(talos, plan, frames, 0.0, ik, wanted, Blocked())[1] == []
+
+
+def test_a_centred_one_foot_posture_whose_step_cannot_be_made_is_the_plans(plan, monkeypatch):
+    """Where a single support next to a one-foot posture centred in its sole cannot be made, the
+    motion takes that posture as the plan has it, and every other centred one stays centred."""
+    from leas_jax.motion import motion as module
+
+    # the median of this plan's one-foot postures' margins (6.3 cm of the sole's 6.5): some are centred
+    config = MotionConfig(single_support_margin=float(np.median(list(_one_foot_margins(plan).values()))))
+    centred = make_motion(plan, config, check=False)
+    assert centred.moved_keys.size > 1
+    refused = int(centred.moved_keys[0])
+    real = module._segment_phases
+
+    def segment(made, k, *args, **kwargs):
+        if refused in (k, k + 1) and not np.array_equal(made.q[refused], plan.q[refused]):
+            raise MotionError(f"postures {k} and {k + 1}: refused by the test")
+        return real(made, k, *args, **kwargs)
+
+    monkeypatch.setattr(module, "_segment_phases", segment)
+    made = make_motion(plan, config, check=False)
+    assert refused not in made.moved_keys and set(made.moved_keys) == set(centred.moved_keys) - {refused}
+    np.testing.assert_array_equal(made.q[made.key_index[refused]], plan.q[refused])
+
+
+def _one_foot_margins(plan) -> dict:
+    """{k: m} how far inside its stance sole each one-foot posture k holds its CoM."""
+    from leas_jax.motion.motion import sole_corners, support_margin
+
+    talos = load_talos()
+    on = ~np.isnan(plan.feet[:, :, 0])
+    margins = {}
+    for k in range(1, len(plan)):
+        if on[k].sum() == 1:
+            feet, com, _ = posture_frames(talos, plan.q[k])
+            margins[k] = support_margin(sole_corners(feet, on[k]), com[:2])
+    return margins
 
 
 def _Spec(upper0, upper1):

@@ -1474,7 +1474,8 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     as before), and one that still fails once more slower (`MotionConfig.slowed_duration`);
     a single support whose stance sole's centre of pressure comes within
     `MotionConfig.pressure_margin` of its edges is made again the same way. Every other phase
-    is made as before (and not sampled again).
+    is made as before (and not sampled again). A one-foot posture centred in its stance sole
+    (`centred_postures`) whose single support cannot be made is taken as the plan has it.
 
     Args:
         plan: the contact plan (at least 2 postures).
@@ -1501,11 +1502,12 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     clearance = BodyClearance(talos, terrain)
     original = plan
     frames = [posture_frames(talos, q) for q in plan.q]
-    keys, moved = centred_postures(
+    keys, centred = centred_postures(
         talos, plan, frames, config.support_margin, ik, config.single_support_margin, clearance
     )
+    one_foot = {k for k in centred if not _contacts(plan, k).all()}  # one-foot postures centred
     keys, tucked = tucked_arms(keys, clearance)
-    moved = sorted(set(moved) | set(tucked))
+    moved = sorted(set(centred) | set(tucked))
     if moved:
         plan = dataclasses.replace(plan, q=keys)
         frames = [posture_frames(talos, q) for q in plan.q]
@@ -1520,14 +1522,30 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     segments = {}  # (k, balanced, slowed): its phase specs, kept across the remakes
     solved = {}  # phases sampled, kept across the remakes (`_sampled_motion`)
     while True:
-        specs = []
+        specs, failed = [], None
         for k in range(len(plan) - 1):
             key = (k, k in balanced, k in slowed)
             if key not in segments:
-                segments[key] = _segment_phases(
-                    plan, k, frames, terrain, slow_config if key[2] else config, talos, key[1], clearance
-                )
+                try:
+                    segments[key] = _segment_phases(
+                        plan, k, frames, terrain, slow_config if key[2] else config, talos, key[1], clearance
+                    )
+                except MotionError:
+                    failed = {k, k + 1} & one_foot
+                    if not failed:
+                        raise
+                    break
             specs.extend(segments[key])
+        if failed:  # a centred one-foot posture whose single support cannot be made: the plan's, as given
+            for j in failed:
+                keys[j, :UPPER_BODY] = original.q[j, :UPPER_BODY]
+                frames[j] = posture_frames(talos, keys[j])
+                for key in [key for key in segments if key[0] in (j - 1, j)]:
+                    del segments[key]
+            one_foot -= failed
+            moved = sorted(set(moved) - (failed - set(tucked)))
+            plan = dataclasses.replace(plan, q=keys)
+            continue
         motion, collided = _sampled_motion(
             plan, original, moved, specs, frames, terrain, config, talos, ik, clearance, solved
         )
@@ -1566,7 +1584,7 @@ def _sampled_motion(
     arms collide made again with a detour (`detoured_phase`); original: the plan as given
     (`Motion.plan_q`), moved: the key postures reached otherwise (`Motion.moved_keys`). Raises
     MotionError naming the phase whose swing meets the terrain, whose IK fails or ends off the
-    next key posture. solved: {id(spec): (first configuration [39], (spec, references,
+    next key posture. solved: {id(spec): (spec, first configuration [39], (spec, references,
     configurations, messages))} of phases sampled before, reused where a phase starts from the
     same configuration, and added to (None: nothing kept)."""
     q_samples, feet_samples, com_samples, contact_samples = [plan.q[0]], [frames[0][0]], [frames[0][1]], []
@@ -1577,13 +1595,13 @@ def _sampled_motion(
         start = len(q_samples) - 1
         phase = Phase(spec.kind, start, start + spec.samples, spec.postures, spec.swing)
         ends_segment = _ends_segment(specs, spec)
-        earlier = (solved or {}).get(id(spec))
-        if earlier is not None and np.array_equal(earlier[0], q_samples[-1]):
-            sampled = earlier[1]
+        earlier = (solved or {}).get(id(spec))  # it holds spec itself: no other object takes its id
+        if earlier is not None and earlier[0] is spec and np.array_equal(earlier[1], q_samples[-1]):
+            sampled = earlier[2]
         else:
             sampled = _sampled_phase(spec, phase, q_samples[-1], terrain, config, talos, ik, clearance)
             if solved is not None:
-                solved[id(spec)] = (q_samples[-1], sampled)
+                solved[id(spec)] = (spec, q_samples[-1], sampled)
         spec, references, configurations, messages = sampled
         in_contact = np.array([side != spec.swing for side in (0, 1)])
         for q, ref, message in zip(configurations, references, messages):

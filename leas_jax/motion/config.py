@@ -107,20 +107,18 @@ class MotionConfig:
     # dynamics (`Motion.wrenches`: the CoM's acceleration and the swing leg's angular momentum,
     # which the equilibrium check leaves out), must lie on the sole (`check_motion`, "centre
     # of pressure"), and a single support that keeps it less than this far inside the sole's
-    # edges, m, is made again as one that fails the equilibrium check is. MuJoCo tracks the
-    # CoM within 1-1.5 cm; the plans' landings took it 1.8 cm past a sole's side edge on
-    # rubbles_stairs_3_1 and to its toe on darpa_0, where Talos rolled over the edge, slipped
-    # 1.1-1.4 cm and fell (docs/results/2026-12-07-motion-arm-detours).
+    # edges, m, is made again slower (`slowed_duration`). MuJoCo tracks the CoM within
+    # 1-1.5 cm; on darpa_0 the plan's single supports took it to a sole's toe, where Talos
+    # rolled over the edge and fell (docs/results/2026-12-07-motion-arm-detours).
     pressure_margin: float = 0.02
-    # A single support that still fails the equilibrium check, or keeps its centre of pressure
-    # under `pressure_margin`, with its CoM kept inside the stance sole (`root_shift`) is made
-    # once more slower: its lift and landing last `slowed_duration` times as long and its CoM
-    # accelerates at most `slowed_acceleration`, m/s^2 (a CoM 3 cm inside the sole's edge
-    # leaves the zero-moment point inside it up to 3 cm * g / h = 0.33 m/s^2, h = 0.90 m; on
-    # talos_stairs15_0's landing 25 -> 26 a 0.41 m/s^2 swing of the CoM took the robustness to
-    # -0.68). On darpa_0 twice as long single supports kept every centre of pressure 1.4 cm
-    # inside its sole, against 0.4 mm outside (docs/results/2026-12-07-motion-arm-detours).
-    # slowed_duration 0: not made again.
+    # A single support made again slower (one that still fails the equilibrium check with its
+    # CoM kept inside the stance sole, `root_shift`, or keeps its centre of pressure under
+    # `pressure_margin`): its lift and landing last `slowed_duration` times as long and its
+    # CoM accelerates at most `slowed_acceleration`, m/s^2 (a CoM 3 cm inside the sole's edge
+    # leaves the zero-moment point inside it up to 3 cm * g / h = 0.33 m/s^2, h = 0.90 m). On
+    # talos_stairs15_0's landing 25 -> 26 the CoM's sideways swing took the robustness below 0,
+    # and on darpa_0 twice as long single supports kept the centres of pressure further inside
+    # their soles (docs/results/2026-12-07-motion-arm-detours/diagnose.txt). 0: not made again.
     slowed_acceleration: float = 0.25
     slowed_duration: float = 2.0
     # Sole corners on the swing path may sink this far below the terrain surface, m (the

@@ -1469,12 +1469,11 @@ def _swing_clearance(terrain, spec: _PhaseSpec, references, config: MotionConfig
 def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check: bool = True) -> Motion:
     """A whole-body motion through every key posture of `plan`, at rest at each.
 
-    A single support that fails the equilibrium check is made again once with its CoM kept
-    inside the stance sole (`shifted_support`, the shifts from none up; where it cannot,
-    as before), and one that still fails once more slower (`MotionConfig.slowed_duration`);
-    a single support whose stance sole's centre of pressure comes within
-    `MotionConfig.pressure_margin` of its edges is made again the same way. Every other phase
-    is made as before (and not sampled again). A one-foot posture centred in its stance sole
+    A single support that fails the equilibrium check is made again with its CoM kept inside
+    the stance sole (`shifted_support`, the shifts from none up; where it cannot, as before),
+    and one that still fails, or whose stance sole's centre of pressure comes within
+    `MotionConfig.pressure_margin` of its edges, slower (`MotionConfig.slowed_duration`); at
+    most two remakes. Every other phase is made as before (and not sampled again). A one-foot posture centred in its stance sole
     (`centred_postures`) whose single support cannot be made is taken as the plan has it.
 
     Args:
@@ -1521,6 +1520,7 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     )
     segments = {}  # (k, balanced, slowed): its phase specs, kept across the remakes
     solved = {}  # phases sampled, kept across the remakes (`_sampled_motion`)
+    remakes = 0
     while True:
         specs, failed = [], None
         for k in range(len(plan) - 1):
@@ -1550,21 +1550,21 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
             plan, original, moved, specs, frames, terrain, config, talos, ik, clearance, solved
         )
         failures = check_motion(motion, config, clearance, collided)
-        unbalanced = {
+        if remakes == 2:
+            break
+        remakes += 1
+        tipping = {
             motion.phases[index].postures[0]
             for _, index, name, _ in failures
             if name == "equilibrium" and motion.phases[index].single_support
-        } | off_centre_segments(motion, config.pressure_margin)
-        if not unbalanced or slowed:
+        }
+        rebalance = tipping - balanced if config.root_shift > 0.0 else set()
+        slow = set()
+        if config.slowed_duration > 0.0:
+            slow = ((tipping - rebalance) | off_centre_segments(motion, config.pressure_margin)) - slowed
+        if not rebalance and not slow:
             break
-        if not balanced and config.root_shift > 0.0:
-            balanced = unbalanced
-        elif config.slowed_duration > 0.0:
-            slowed = unbalanced
-            if config.root_shift > 0.0:
-                balanced = balanced | unbalanced
-        else:
-            break
+        balanced, slowed = balanced | rebalance, slowed | slow
     if check and failures:
         sample, index, name, message = failures[0]
         raise MotionError(

@@ -73,9 +73,9 @@ class MotionConfig:
     # CoM is less than this far inside its stance sole is reached with its CoM moved inside,
     # its soles, root orientation and upper body kept, where that stays within the joint
     # limits and collides nowhere. The contact generator's one-foot postures need only be in
-    # equilibrium: rubbles_stairs_3_1's 239 holds its CoM 5 mm from the sole's side edge,
-    # and Talos rolled over that edge and fell there however slowly the swing moved
-    # (docs/results/2026-12-07-motion-arm-detours).
+    # equilibrium: rubbles_stairs_3_1's 239 holds its CoM 4.8 mm from the sole's side edge,
+    # and Talos rolled over that edge and fell there
+    # (docs/results/2026-12-07-motion-arm-detours: diagnose.txt, and the motions executed).
     single_support_margin: float = 0.03
     # Single-support configurations (held, profiled or shifted root) keep every geometry of
     # Talos but the feet this far from the terrain, m, or as far as the plan's one-foot
@@ -115,10 +115,12 @@ class MotionConfig:
     # CoM kept inside the stance sole, `root_shift`, or keeps its centre of pressure under
     # `pressure_margin`): its lift and landing last `slowed_duration` times as long and its
     # CoM accelerates at most `slowed_acceleration`, m/s^2 (a CoM 3 cm inside the sole's edge
-    # leaves the zero-moment point inside it up to 3 cm * g / h = 0.33 m/s^2, h = 0.90 m). On
-    # talos_stairs15_0's landing 25 -> 26 the CoM's sideways swing took the robustness below 0,
-    # and on darpa_0 twice as long single supports kept the centres of pressure further inside
-    # their soles (docs/results/2026-12-07-motion-arm-detours/diagnose.txt). 0: not made again.
+    # leaves the zero-moment point inside it up to 3 cm * g / h = 0.33 m/s^2, h = 0.90 m). Made
+    # without it and without centring its one-foot postures, talos_stairs15_0's landing
+    # 25 -> 26 swung the CoM sideways at 0.41 m/s^2 and took the robustness to -0.68; either
+    # remedy alone makes it. On darpa_0 single supports twice as long kept every centre of
+    # pressure 1.4 cm inside its sole, against 0.04 cm outside
+    # (docs/results/2026-12-07-motion-arm-detours/diagnose.txt). 0: not made again.
     slowed_acceleration: float = 0.25
     slowed_duration: float = 2.0
     # Sole corners on the swing path may sink this far below the terrain surface, m (the

@@ -132,11 +132,11 @@ ARM_CHANGE_REACH = 4
 # elbow (arm_X_4, negative bends it), reached at mid-phase and gone at both ends
 # (`detour_profile`), so every key posture stays the plan's. Tried in this order, the fewest
 # joints and the smallest offsets first, the first whose phase collides nowhere kept. The key
-# postures hold a gripper as near as 5 mm to a debris tile or a stair's wall, and the root's
-# travel in a shift sweeps it in: on slalom_debris_0 a 0.4 rad pitch back clears the
-# fingertip; on talos_stairs15_0 the thigh meets a held-in gripper unless the shoulder rolls
-# out 0.3 rad and the elbow bends 0.5, and where the arms come out beside the stair's wall a
-# 0.6 rad roll is needed (docs/results/2026-12-07-motion-arm-detours).
+# postures may hold a gripper millimetres from the terrain (slalom_debris_0's 35: 4.8 mm from a
+# debris tile) and the root's travel in a shift sweeps it in: there the right shoulder pitches
+# back (0.24 rad, at its limit); on talos_stairs15_0 both elbows bend 1 rad where the thighs
+# meet the held-in grippers, and beside the stair's wall the right shoulder rolls out 0.6 rad
+# with the elbow bent 0.5 (docs/results/2026-12-07-motion-arm-detours/diagnose.txt).
 ARM_DETOURS = tuple(
     sorted(
         (

@@ -43,6 +43,11 @@ and clear as the motion moves the root); give it its own `--plans` folder.
 `--also VARIANT=JSON` simulates each motion once more with other SimulationConfig overrides
 (the motion made once), written as VARIANT.
 
+`--motions DIR` keeps each made motion (`<plan>.npz`, `Motion.save`) and what making it cost or
+why it could not be made (`<plan>.json`, with the commit that made it) in DIR; a later run with
+the same DIR simulates those motions again instead of making them (its make figures are the
+first run's). Empty DIR when the motion code changes.
+
 Writes <out>/motion_execution_<variant>.json and <out>/motion_execution_<variant>.md.
 
 Results: --out (default benchmarks/results/motion); the runs kept are docs/results/2026-12-06-motion/,
@@ -255,13 +260,49 @@ def cause(summary: dict) -> str:
     return "other"
 
 
+def made_motion(path: Path, motions: Path | None, motion_config, simulation_config):
+    """`execute_plan` of the plan file at `path`, or, where `motions` holds its motion (or the
+    reason it could not be made) from an earlier run, that motion simulated again.
+
+    Returns:
+        `Execution`; its make figures are those of the run that made the motion.
+    """
+    from leas_jax.contacts.commands import load_plan_file
+    from leas_jax.files import atomic_write_text
+    from leas_jax.motion.execute import Execution, execute_plan
+    from leas_jax.motion.motion import Motion
+    from leas_jax.motion.simulate import simulate
+    from leas_jax.provenance import git_state
+
+    record = None if motions is None else motions / f"{path.stem}.json"
+    if record is not None and record.is_file():
+        made = json.loads(record.read_text())
+        motion = Motion.load(motions / f"{path.stem}.npz") if made["error"] is None else None
+        rollout = None if motion is None else simulate(motion, config=simulation_config)
+        return Execution(motion, rollout, made["error"], made["make_seconds"], made["make_cpu_seconds"])
+    execution = execute_plan(load_plan_file(path), motion_config, simulation_config)
+    if record is not None:
+        motions.mkdir(parents=True, exist_ok=True)
+        if execution.motion is not None:
+            execution.motion.save(motions / f"{path.stem}.npz")
+        made = {
+            "error": execution.error,
+            "make_seconds": execution.make_seconds,
+            "make_cpu_seconds": execution.make_cpu_seconds,
+            "git": git_state(),
+        }
+        atomic_write_text(record, json.dumps(made))
+    return execution
+
+
 def run(args) -> dict:
     from leas_jax.contacts.commands import load_plan_file
     from leas_jax.motion.config import MotionConfig, SimulationConfig
-    from leas_jax.motion.execute import Execution, execute_plan
+    from leas_jax.motion.execute import Execution
     from leas_jax.motion.simulate import simulate
 
     out = Path(args.out)
+    motions = Path(args.motions) if args.motions else None
     cache = Path(args.plans)
     cache.mkdir(parents=True, exist_ok=True)
     motion_config = MotionConfig(**json.loads(args.motion_config))
@@ -312,7 +353,7 @@ def run(args) -> dict:
                 skipped.append({"plan": path.name, "postures": len(plan)})
                 print(f"{name} {path.name}: skipped ({len(plan)} postures)", flush=True)
                 continue
-            first = execute_plan(plan, motion_config, SimulationConfig(**variants[0][1]))
+            first = made_motion(path, motions, motion_config, SimulationConfig(**variants[0][1]))
             for variant, overrides in variants:
                 execution = first
                 if variant != variants[0][0] and first.motion is not None:
@@ -512,6 +553,11 @@ def main(argv=None) -> int:
         "--combine",
         default=None,
         help="comma-separated variants whose JSON files in --out are merged into --variant's (nothing run)",
+    )
+    parser.add_argument(
+        "--motions",
+        default=None,
+        help="folder keeping each made motion; a plan whose motion is there is simulated again, not made",
     )
     parser.add_argument("--motion-config", default="{}", help="JSON of MotionConfig overrides")
     parser.add_argument("--simulation-config", default="{}", help="JSON of SimulationConfig overrides")

@@ -178,6 +178,11 @@ class SimulationConfig:
     # (docs/results/2026-12-06-motion-clearance). 0: MuJoCo's default, the soles creep
     # (`mjx_replay` replays with it).
     noslip_iterations: int = 5
+    # Collision surface of a terrain with meshes (`robot.terrain_scene`, one of
+    # `robot.MESH_CONTACTS`): "columns", convex columns under its faces (tilted faces stay
+    # planes), or "raster", boxes over its 2 cm heights raster (a tilted face a staircase).
+    # Boxes-only terrains are their boxes either way.
+    mesh_contact: str = "raster"
     # Seconds simulated after the motion's last sample (the robot must stay up).
     settle: float = 0.5
     # Success: the root (base_link) stays above `min_root_height` over the higher sole in

@@ -30,8 +30,10 @@ Pinocchio's [39] (quaternion xyzw, Pinocchio's joint order).
 from __future__ import annotations
 
 import functools
+import math
 import os
 import re
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -302,7 +304,11 @@ def scene_model(terrain_mjcf: str, timestep: float) -> MujocoTalos:
     scene, pin_model = talos_spec()
     scene.visual.map.znear, scene.visual.map.zfar = terrain.visual.map.znear, terrain.visual.map.zfar
     scene.stat.center, scene.stat.extent = terrain.stat.center, terrain.stat.extent
-    scene.attach(terrain, prefix="terrain/", frame=scene.worldbody.add_frame())
+    with warnings.catch_warnings():
+        # MuJoCo warns that a child without an asset dict (the terrain's inline meshes) may
+        # lose its assets when attached again; this scene is compiled once, never attached.
+        warnings.filterwarnings("ignore", message="Attaching a child without asset dict")
+        scene.attach(terrain, prefix="terrain/", frame=scene.worldbody.add_frame())
     scene.option.timestep = timestep
     scene.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     return _wrap(scene.compile(), pin_model)
@@ -312,37 +318,92 @@ def scene_model(terrain_mjcf: str, timestep: float) -> MujocoTalos:
 # resolution when finer), and the height step, m, under which neighbouring cells merge.
 RASTER_SPACING = 0.02
 HEIGHT_QUANTUM = 0.001
+# Steepest mesh face with a column of its own in a physics scene (`surface_columns`), rad:
+# a steeper one (a block's or a stair's riser) is a side of the columns beside it, and a
+# near-vertical face would make a column too thin for its convex hull.
+COLUMN_MAX_SLOPE = math.radians(85.0)
+# Collision surfaces of a mesh terrain's physics scene (`terrain_scene`).
+MESH_CONTACTS = ("columns", "raster")
 
 
-def terrain_scene(terrain, timestep: float) -> MujocoTalos:
+def terrain_scene(terrain, timestep: float, mesh_contact: str = "raster") -> MujocoTalos:
     """Talos in a terrain's physics scene (`scene_model`).
 
     A terrain of boxes only is exported as it is (`terrain_to_mjcf`: one box geom per box).
     MuJoCo collides a mesh geom through its convex hull, so a terrain with meshes (the HPP
     scenes: a room's floor, a staircase) would be a solid block; its collision surface is
-    then `raster_boxes`: boxes over the cells of its heights raster (`Terrain.height_at`,
-    exact ray casts on the boxes and the meshes' triangles). A MuJoCo height field of the
-    same heights was measured first: on flat ground its box contacts make the flat-ground
-    test motion fall (1 cm samples) or slip 1 cm (20 cm samples).
+    then made of convex pieces:
+
+    - "columns" (default): its boxes as boxes, and under each convex piece of its meshes'
+      upward faces a convex column down to the void (`surface_columns`): every face, tilted
+      ones included, is the plane it is, and a sole on it meets one convex geom.
+    - "raster": boxes over the cells of its heights raster (`raster_boxes`; `Terrain.height_at`,
+      exact ray casts on the boxes and the meshes' triangles). A tilted face becomes a
+      staircase of steps (5 mm on a 15 deg face at 2 cm cells) on which soles slip and roll
+      (docs/results/2026-12-07-motion-mesh-contact).
+
+    A MuJoCo height field of the same heights was measured first: on flat ground its box
+    contacts make the flat-ground test motion fall (1 cm samples) or slip 1 cm (20 cm samples).
 
     Args:
         terrain: a `Terrain` (world frame).
         timestep: physics step, s.
+        mesh_contact: one of MESH_CONTACTS.
     """
-    from leas_jax.terrain.export import terrain_to_mjcf
+    from leas_jax.terrain.export import box_geoms, terrain_to_mjcf
 
+    if mesh_contact not in MESH_CONTACTS:
+        raise ValueError(f"mesh_contact: expected one of {', '.join(MESH_CONTACTS)}, got {mesh_contact!r}")
     if not terrain.meshes:
         return scene_model(terrain_to_mjcf(terrain), timestep)
-    boxes = raster_boxes(terrain)
-    lines = ["<mujoco>", "  <worldbody>"]
-    for i, (lo, hi) in enumerate(boxes):
-        centre, half = (lo + hi) / 2.0, (hi - lo) / 2.0
-        lines.append(
-            f'    <geom name="raster{i}" type="box" pos="{centre[0]:.6f} {centre[1]:.6f} {centre[2]:.6f}" '
-            f'size="{half[0]:.6f} {half[1]:.6f} {half[2]:.6f}"/>'
-        )
-    lines += ["  </worldbody>", "</mujoco>"]
-    return scene_model("\n".join(lines), timestep)
+    assets, lines = [], []
+    if mesh_contact == "raster":
+        for i, (lo, hi) in enumerate(raster_boxes(terrain)):
+            centre, half = (lo + hi) / 2.0, (hi - lo) / 2.0
+            lines.append(
+                f'    <geom name="raster{i}" type="box" pos="{centre[0]:.6f} {centre[1]:.6f} {centre[2]:.6f}" '
+                f'size="{half[0]:.6f} {half[1]:.6f} {half[2]:.6f}"/>'
+            )
+    else:
+        lines = box_geoms(terrain)
+        for i, column in enumerate(surface_columns(terrain)):
+            assets.append(
+                f'    <mesh name="column{i}" vertex="{" ".join(f"{v:.9g}" for v in column.reshape(-1))}"/>'
+            )
+            lines.append(f'    <geom name="column{i}" type="mesh" mesh="column{i}"/>')
+    mjcf = [
+        "<mujoco>",
+        "  <asset>",
+        *assets,
+        "  </asset>",
+        "  <worldbody>",
+        *lines,
+        "  </worldbody>",
+        "</mujoco>",
+    ]
+    return scene_model("\n".join(mjcf), timestep)
+
+
+def surface_columns(terrain) -> list[np.ndarray]:
+    """Convex columns whose union's top is the surface of the terrain's meshes.
+
+    Each is the prism under one convex piece of coplanar upward faces (`support_polygons`
+    over every face up to COLUMN_MAX_SLOPE, covered faces left out) down to `void_height`:
+    what lies under a face is solid, as in the terrain's heights raster.
+
+    Returns:
+        list of [2N, 3] vertices (world, m): the piece's N corners, then the same corners
+        at `void_height`.
+    """
+    from leas_jax.terrain.mesh import support_polygons
+
+    pieces = support_polygons(terrain.meshes, math.tan(COLUMN_MAX_SLOPE), terrain.height_at)
+    bottom = float(terrain.void_height)
+    return [
+        np.concatenate([p.vertices, np.c_[p.vertices[:, :2], np.full(len(p.vertices), bottom)]])
+        for p in pieces
+        if p.vertices[:, 2].min() > bottom
+    ]
 
 
 def raster_boxes(terrain, spacing: float | None = None) -> list[tuple[np.ndarray, np.ndarray]]:

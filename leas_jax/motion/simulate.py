@@ -209,7 +209,7 @@ def simulate(
     started, cpu_started = clock.perf_counter(), clock.process_time()
     if terrain is None:
         terrain = loads_terrain(motion.terrain, source="<motion terrain>")
-    mj = terrain_scene(terrain, config.timestep)
+    mj = terrain_scene(terrain, config.timestep, config.mesh_contact)
     mj.model.opt.noslip_iterations = config.noslip_iterations
     talos = load_talos()
     model = mj.model

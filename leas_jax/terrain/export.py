@@ -61,15 +61,20 @@ def terrain_to_mjcf(terrain: Terrain) -> str:
         "  <worldbody>",
         f'    <light pos="{_fmt([(xmin + xmax) / 2, (ymin + ymax) / 2, 10.0])}" dir="0 0 -1" directional="true"/>',
     ]
-    for index, box in enumerate(terrain.boxes):
-        lines.append(
-            f'    <geom name="box{index}" type="box" pos="{_fmt(box.center)}" '
-            f'size="{_fmt(box.half)}" quat="{_fmt(box.quaternion_wxyz)}"/>'
-        )
+    lines += box_geoms(terrain)
     for index in range(len(terrain.meshes)):
         lines.append(f'    <geom name="mesh{index}" type="mesh" mesh="mesh{index}"/>')
     lines += ["  </worldbody>", "</mujoco>", ""]
     return "\n".join(lines)
+
+
+def box_geoms(terrain: Terrain) -> list[str]:
+    """`<geom type="box">` lines of the terrain's boxes, named box0, box1, ... in box order."""
+    return [
+        f'    <geom name="box{index}" type="box" pos="{_fmt(box.center)}" '
+        f'size="{_fmt(box.half)}" quat="{_fmt(box.quaternion_wxyz)}"/>'
+        for index, box in enumerate(terrain.boxes)
+    ]
 
 
 def _mesh_assets(terrain: Terrain) -> list[str]:

@@ -265,6 +265,53 @@ def test_one_foot_postures_near_their_sole_edge_are_centred(plan):
     assert centred_postures(talos, plan, frames, 0.0, ik, wanted, Blocked())[1] == []
 
 
+def test_a_one_foot_posture_whose_swing_leg_is_at_its_reach_is_centred_with_its_swing_sole_carried(plan):
+    from leas_jax.motion.motion import _centred_configuration, centred_com, sole_corners
+    from leas_jax.motion.wbik import IKError, WholeBodyIK
+
+    talos = load_talos()
+    config = MotionConfig()
+    ik = WholeBodyIK(talos, config.ik_iterations, config.ik_damping, config.ik_tolerance)
+    on = ~np.isnan(plan.feet[:, :, 0])
+    k = next(k for k in range(1, len(plan)) if on[k].sum() == 1)
+    feet, com, rotation = posture_frames(talos, plan.q[k])
+    target = centred_com(sole_corners(feet, on[k]), com, 0.065)  # the sole's centre line
+    swing = int(np.flatnonzero(~on[k])[0])
+    assert np.linalg.norm(target[:2] - com[:2]) > 1e-3
+
+    class AtReach:  # the real IK, but the swing sole cannot stay where it is
+        def solve(self, q, targets):
+            if np.allclose(targets.feet[swing], feet[swing]):
+                raise IKError("IK residual on the swing sole (the test's leg at its reach)")
+            return ik.solve(q, targets)
+
+    q = _centred_configuration(AtReach(), plan.q[k], feet, com, target, rotation, on[k])
+    moved_feet, moved_com, moved_rotation = posture_frames(talos, q)
+    np.testing.assert_allclose(moved_com, target, atol=1e-6)
+    np.testing.assert_allclose(moved_feet[1 - swing], feet[1 - swing], atol=1e-6)  # stance sole kept
+    carried = feet[swing].copy()
+    carried[:2, 3] += target[:2] - com[:2]
+    np.testing.assert_allclose(moved_feet[swing], carried, atol=1e-6)  # the swing sole moved as the CoM
+    np.testing.assert_allclose(moved_rotation, rotation, atol=1e-6)
+
+    class Unreachable:
+        def solve(self, q, targets):
+            raise IKError("nothing reaches")
+
+    assert _centred_configuration(Unreachable(), plan.q[k], feet, com, target, rotation, on[k]) is None
+    both = next(j for j in range(1, len(plan)) if on[j].all())  # both soles down: nothing to carry
+    feet2, com2, rotation2 = posture_frames(talos, plan.q[both])
+    calls = []
+
+    class Counting:
+        def solve(self, q, targets):
+            calls.append(targets)
+            raise IKError("nothing reaches")
+
+    assert _centred_configuration(Counting(), plan.q[both], feet2, com2, com2, rotation2, on[both]) is None
+    assert len(calls) == 1  # a two-foot posture keeps its soles: one try
+
+
 def test_a_centred_one_foot_posture_whose_step_cannot_be_made_is_the_plans(plan, monkeypatch):
     """Where a single support next to a one-foot posture centred in its sole cannot be made, the
     motion takes that posture as the plan has it, and every other centred one stays centred."""

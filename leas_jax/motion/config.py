@@ -183,6 +183,12 @@ class SimulationConfig:
     # planes), or "raster", boxes over its 2 cm heights raster (a tilted face a staircase).
     # Boxes-only terrains are their boxes either way.
     mesh_contact: str = "raster"
+    # Friction cone of the contacts (`mjOption.cone`: "pyramidal" or "elliptic") and the
+    # ratio of the frictional to the normal constraints' impedance (`mjOption.impratio`):
+    # MuJoCo's default 1 lets a sole loaded along a slope creep down it even within the
+    # cone; MuJoCo's documentation advises raising it, with elliptic cones, against slip.
+    cone: str = "pyramidal"
+    impratio: float = 1.0
     # Seconds simulated after the motion's last sample (the robot must stay up).
     settle: float = 0.5
     # Success: the root (base_link) stays above `min_root_height` over the higher sole in

@@ -8,7 +8,8 @@ first configuration and, at every physics step (1 kHz), applies
 with q_ref, v_ref, tau_ff interpolated linearly between the motion's 100 Hz samples and the
 gains of `simulate.pd_gains`, as `simulate.simulate` does on CPU MuJoCo (the default and the
 judge: falls, landings, slip, torque and other terrain contacts are measured there). The
-model is `robot.scene_model`'s with one difference: only the sole boxes collide with the
+model is `simulate`'s (`robot.scene_model` of `robot.physics_terrain_mjcf`, the same friction
+solver) with one difference: only the sole boxes collide with the
 terrain, as MJX has no collisions for the links' cylinders and meshes; a motion that
 `simulate` passes touches the terrain with its soles alone, so the physics is the same but
 for the noslip solver, which `simulate` runs by default (`SimulationConfig.noslip_iterations`)
@@ -71,10 +72,10 @@ def mjx_scene(terrain, config: SimulationConfig = SimulationConfig()):
     """(MujocoTalos, mjx.Model) of Talos in `terrain`, only its sole boxes colliding."""
     from mujoco import mjx
 
-    from leas_jax.motion.robot import scene_model
-    from leas_jax.terrain.export import terrain_to_mjcf
+    from leas_jax.motion.robot import physics_terrain_mjcf, scene_model, set_friction_solver
 
-    mj = scene_model(terrain_to_mjcf(terrain), config.timestep)
+    mj = scene_model(physics_terrain_mjcf(terrain, config.mesh_contact), config.timestep)
+    set_friction_solver(mj.model, config.cone, config.impratio)
     soles = set(mj.sole_geoms)
     for geom in mj.robot_geoms:
         if geom not in soles:

@@ -990,13 +990,11 @@ def centred_postures(
     """The plan's postures [K, 39] with every posture after the first whose CoM is less than
     `margin` m (double support) or `single_margin` m (single support) inside its soles'
     support polygon moved (`centred_com`, whole-body IK from the posture: soles, root
-    orientation and upper body kept), and the moved indices.
+    orientation and upper body kept; `_centred_configuration`), and the moved indices.
 
-    A posture the IK cannot move (IKError), or whose move takes a joint past its limits or
-    collides (`BodyClearance.collisions` of clearance, where given), stays the plan's.
+    A posture the IK cannot move, or whose move takes a joint past its limits or collides
+    (`BodyClearance.collisions` of clearance, where given), stays the plan's.
     """
-    from leas_jax.motion.wbik import IKError, Targets
-
     q = np.array(plan.q, dtype=np.float64)
     lower, upper = talos.model.lowerPositionLimit[7:], talos.model.upperPositionLimit[7:]
     moved = []
@@ -1009,17 +1007,38 @@ def centred_postures(
         target = centred_com(sole_corners(feet, on), com, wanted)
         if np.allclose(target, com):
             continue
-        try:
-            centred = ik.solve(q[k], Targets(feet, target, rotation, q[k]))
-        except IKError:
-            continue
-        if ((centred[7:] < lower) | (centred[7:] > upper)).any():
+        centred = _centred_configuration(ik, q[k], feet, com, target, rotation, on)
+        if centred is None or ((centred[7:] < lower) | (centred[7:] > upper)).any():
             continue
         if clearance is not None and clearance.collisions(centred):
             continue
         q[k] = centred
         moved.append(k)
     return q, moved
+
+
+def _centred_configuration(ik, q, feet, com, target, rotation, on) -> np.ndarray | None:
+    """Whole-body IK of posture q [39] with its CoM [3] moved to target [3], soles feet
+    [2, 4, 4] (those `on` the ground), root rotation [3, 3] and upper body kept; None when
+    the IK cannot reach.
+
+    A one-foot posture's swing leg may be at its reach (darpa_0's 54: the IK misses the
+    swing sole by 0.8 mm for a 3 mm move of the CoM): where the IK cannot keep the swing sole,
+    the swing sole moves with the CoM (horizontally, as far), the legs as they were.
+    """
+    from leas_jax.motion.wbik import IKError, Targets
+
+    attempts = [feet]
+    if not on.all():
+        carried = feet.copy()
+        carried[~on, :2, 3] += target[:2] - com[:2]
+        attempts.append(carried)
+    for soles in attempts:
+        try:
+            return ik.solve(q, Targets(soles, target, rotation, q))
+        except IKError:
+            continue
+    return None
 
 
 def _segment_phases(

@@ -314,6 +314,22 @@ def scene_model(terrain_mjcf: str, timestep: float) -> MujocoTalos:
     return _wrap(scene.compile(), pin_model)
 
 
+# MuJoCo's friction cones by `SimulationConfig.cone`.
+CONES = ("pyramidal", "elliptic")
+
+
+def set_friction_solver(model, cone: str, impratio: float) -> None:
+    """Set a MuJoCo model's friction cone (one of CONES) and impratio (> 0), in place."""
+    import mujoco
+
+    if cone not in CONES:
+        raise ValueError(f"cone: expected one of {', '.join(CONES)}, got {cone!r}")
+    if not impratio > 0.0:
+        raise ValueError(f"impratio: expected a positive number, got {impratio!r}")
+    model.opt.cone = mujoco.mjtCone.mjCONE_ELLIPTIC if cone == "elliptic" else mujoco.mjtCone.mjCONE_PYRAMIDAL
+    model.opt.impratio = impratio
+
+
 # Raster of a mesh terrain's physics scene: cell size, m (at most; the terrain's own
 # resolution when finer), and the height step, m, under which neighbouring cells merge.
 RASTER_SPACING = 0.02
@@ -327,16 +343,27 @@ MESH_CONTACTS = ("columns", "raster")
 
 
 def terrain_scene(terrain, timestep: float, mesh_contact: str = "raster") -> MujocoTalos:
-    """Talos in a terrain's physics scene (`scene_model`).
+    """Talos in a terrain's physics scene: `scene_model` of `physics_terrain_mjcf`.
+
+    Args:
+        terrain: a `Terrain` (world frame).
+        timestep: physics step, s.
+        mesh_contact: one of MESH_CONTACTS (`physics_terrain_mjcf`).
+    """
+    return scene_model(physics_terrain_mjcf(terrain, mesh_contact), timestep)
+
+
+def physics_terrain_mjcf(terrain, mesh_contact: str = "raster") -> str:
+    """MJCF of a terrain's collision surface (world frame).
 
     A terrain of boxes only is exported as it is (`terrain_to_mjcf`: one box geom per box).
     MuJoCo collides a mesh geom through its convex hull, so a terrain with meshes (the HPP
     scenes: a room's floor, a staircase) would be a solid block; its collision surface is
     then made of convex pieces:
 
-    - "columns" (default): its boxes as boxes, and under each convex piece of its meshes'
-      upward faces a convex column down to the void (`surface_columns`): every face, tilted
-      ones included, is the plane it is, and a sole on it meets one convex geom.
+    - "columns": its boxes as boxes, and under each convex piece of its meshes' upward
+      faces a convex column down to the void (`surface_columns`): every face, tilted ones
+      included, is the plane it is, and a sole on it meets one convex geom.
     - "raster": boxes over the cells of its heights raster (`raster_boxes`; `Terrain.height_at`,
       exact ray casts on the boxes and the meshes' triangles). A tilted face becomes a
       staircase of steps (5 mm on a 15 deg face at 2 cm cells) on which soles slip and roll
@@ -346,16 +373,18 @@ def terrain_scene(terrain, timestep: float, mesh_contact: str = "raster") -> Muj
     contacts make the flat-ground test motion fall (1 cm samples) or slip 1 cm (20 cm samples).
 
     Args:
-        terrain: a `Terrain` (world frame).
-        timestep: physics step, s.
+        terrain: a `Terrain`.
         mesh_contact: one of MESH_CONTACTS.
+
+    Raises:
+        ValueError: an unknown `mesh_contact`.
     """
     from leas_jax.terrain.export import box_geoms, terrain_to_mjcf
 
     if mesh_contact not in MESH_CONTACTS:
         raise ValueError(f"mesh_contact: expected one of {', '.join(MESH_CONTACTS)}, got {mesh_contact!r}")
     if not terrain.meshes:
-        return scene_model(terrain_to_mjcf(terrain), timestep)
+        return terrain_to_mjcf(terrain)
     assets, lines = [], []
     if mesh_contact == "raster":
         for i, (lo, hi) in enumerate(raster_boxes(terrain)):
@@ -381,7 +410,7 @@ def terrain_scene(terrain, timestep: float, mesh_contact: str = "raster") -> Muj
         "  </worldbody>",
         "</mujoco>",
     ]
-    return scene_model("\n".join(mjcf), timestep)
+    return "\n".join(mjcf)
 
 
 def surface_columns(terrain) -> list[np.ndarray]:

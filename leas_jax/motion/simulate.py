@@ -203,7 +203,7 @@ def simulate(
     import mujoco
 
     from leas_jax.contacts.robot.model import load_talos
-    from leas_jax.motion.robot import terrain_scene
+    from leas_jax.motion.robot import set_friction_solver, terrain_scene
     from leas_jax.terrain import loads_terrain
 
     started, cpu_started = clock.perf_counter(), clock.process_time()
@@ -211,6 +211,7 @@ def simulate(
         terrain = loads_terrain(motion.terrain, source="<motion terrain>")
     mj = terrain_scene(terrain, config.timestep, config.mesh_contact)
     mj.model.opt.noslip_iterations = config.noslip_iterations
+    set_friction_solver(mj.model, config.cone, config.impratio)
     talos = load_talos()
     model = mj.model
     data = mujoco.MjData(model)

@@ -178,17 +178,23 @@ class SimulationConfig:
     # (docs/results/2026-12-06-motion-clearance). 0: MuJoCo's default, the soles creep
     # (`mjx_replay` replays with it).
     noslip_iterations: int = 5
-    # Collision surface of a terrain with meshes (`robot.terrain_scene`, one of
-    # `robot.MESH_CONTACTS`): "columns", convex columns under its faces (tilted faces stay
-    # planes), or "raster", boxes over its 2 cm heights raster (a tilted face a staircase).
-    # Boxes-only terrains are their boxes either way.
-    mesh_contact: str = "raster"
+    # Collision surface of a terrain with meshes (`robot.physics_terrain_mjcf`, one of
+    # `robot.MESH_CONTACTS`): "columns", a convex column under each convex piece of its
+    # faces, so that a tilted face stays a plane, or "raster", boxes over its 2 cm heights
+    # raster, a tilted face a staircase of 5 mm steps (15 deg). Boxes-only terrains are their
+    # boxes either way. On the raster, talos_plateformes_0 fell on its 15 deg platforms and
+    # darpa_0 on its tilted blocks (docs/results/2026-12-07-motion-mesh-contact).
+    mesh_contact: str = "columns"
     # Friction cone of the contacts (`mjOption.cone`: "pyramidal" or "elliptic") and the
-    # ratio of the frictional to the normal constraints' impedance (`mjOption.impratio`):
-    # MuJoCo's default 1 lets a sole loaded along a slope creep down it even within the
-    # cone; MuJoCo's documentation advises raising it, with elliptic cones, against slip.
-    cone: str = "pyramidal"
-    impratio: float = 1.0
+    # ratio of the frictional to the normal constraints' impedance (`mjOption.impratio`).
+    # With MuJoCo's defaults (pyramidal, 1) a sole loaded along a 15 deg face creeps down it
+    # though the load stays well inside the friction cone (talos_plateformes_0: 0.26-0.30 of
+    # the normal force against mu = 0.5, 1.1-1.2 cm per phase, the noslip solver on); MuJoCo's
+    # documentation advises elliptic cones with impratio > 1 against slip. At 10 the same
+    # soles hold (0.15 cm at most over the motion) and a sole-sized box pushed along a 15 deg
+    # slope stays (tests/test_motion_terrain.py).
+    cone: str = "elliptic"
+    impratio: float = 10.0
     # Seconds simulated after the motion's last sample (the robot must stay up).
     settle: float = 0.5
     # Success: the root (base_link) stays above `min_root_height` over the higher sole in

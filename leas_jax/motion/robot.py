@@ -342,18 +342,18 @@ COLUMN_MAX_SLOPE = math.radians(85.0)
 MESH_CONTACTS = ("columns", "raster")
 
 
-def terrain_scene(terrain, timestep: float, mesh_contact: str = "raster") -> MujocoTalos:
+def terrain_scene(terrain, timestep: float, mesh_contact: str) -> MujocoTalos:
     """Talos in a terrain's physics scene: `scene_model` of `physics_terrain_mjcf`.
 
     Args:
         terrain: a `Terrain` (world frame).
         timestep: physics step, s.
-        mesh_contact: one of MESH_CONTACTS (`physics_terrain_mjcf`).
+        mesh_contact: one of MESH_CONTACTS (`physics_terrain_mjcf`; `SimulationConfig.mesh_contact`).
     """
     return scene_model(physics_terrain_mjcf(terrain, mesh_contact), timestep)
 
 
-def physics_terrain_mjcf(terrain, mesh_contact: str = "raster") -> str:
+def physics_terrain_mjcf(terrain, mesh_contact: str) -> str:
     """MJCF of a terrain's collision surface (world frame).
 
     A terrain of boxes only is exported as it is (`terrain_to_mjcf`: one box geom per box).

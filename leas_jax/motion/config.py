@@ -188,8 +188,9 @@ class SimulationConfig:
     # Friction cone of the contacts (`mjOption.cone`: "pyramidal" or "elliptic") and the
     # ratio of the frictional to the normal constraints' impedance (`mjOption.impratio`).
     # With MuJoCo's defaults (pyramidal, 1) a sole loaded along a 15 deg face creeps down it
-    # though the load stays well inside the friction cone (talos_plateformes_0: 0.26-0.30 of
-    # the normal force against mu = 0.5, 1.1-1.2 cm per phase, the noslip solver on); MuJoCo's
+    # though the load stays well inside the friction cone (talos_plateformes_0 on columns: a
+    # tangential force 0.23-0.31 of the normal one against mu = 0.5, up to 1.2 cm in a phase,
+    # the noslip solver on; docs/results/2026-12-07-motion-mesh-contact/diagnose.txt); MuJoCo's
     # documentation advises elliptic cones with impratio > 1 against slip. At 10 the same
     # soles hold (0.15 cm at most over the motion) and a sole-sized box pushed along a 15 deg
     # slope stays (tests/test_motion_terrain.py).

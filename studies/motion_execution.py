@@ -260,9 +260,11 @@ def cause(summary: dict) -> str:
     return "other"
 
 
-def made_motion(path: Path, motions: Path | None, motion_config, simulation_config):
+def made_motion(path: Path, motions: Path | None, motion_config, simulation_config, git: dict):
     """`execute_plan` of the plan file at `path`, or, where `motions` holds its motion (or the
-    reason it could not be made) from an earlier run, that motion simulated again.
+    reason it could not be made) from an earlier run, that motion simulated again; `git`
+    (`provenance.git_state()` when the run started: the code that makes the motion) is kept
+    with it.
 
     Returns:
         `Execution`; its make figures are those of the run that made the motion.
@@ -272,7 +274,6 @@ def made_motion(path: Path, motions: Path | None, motion_config, simulation_conf
     from leas_jax.motion.execute import Execution, execute_plan
     from leas_jax.motion.motion import Motion
     from leas_jax.motion.simulate import simulate
-    from leas_jax.provenance import git_state
 
     record = None if motions is None else motions / f"{path.stem}.json"
     if record is not None and record.is_file():
@@ -289,7 +290,7 @@ def made_motion(path: Path, motions: Path | None, motion_config, simulation_conf
             "error": execution.error,
             "make_seconds": execution.make_seconds,
             "make_cpu_seconds": execution.make_cpu_seconds,
-            "git": git_state(),
+            "git": git,
         }
         atomic_write_text(record, json.dumps(made))
     return execution
@@ -300,7 +301,9 @@ def run(args) -> dict:
     from leas_jax.motion.config import MotionConfig, SimulationConfig
     from leas_jax.motion.execute import Execution
     from leas_jax.motion.simulate import simulate
+    from leas_jax.provenance import git_state
 
+    git = git_state()  # the code this process loaded, whatever the checkout holds later
     out = Path(args.out)
     motions = Path(args.motions) if args.motions else None
     cache = Path(args.plans)
@@ -353,7 +356,7 @@ def run(args) -> dict:
                 skipped.append({"plan": path.name, "postures": len(plan)})
                 print(f"{name} {path.name}: skipped ({len(plan)} postures)", flush=True)
                 continue
-            first = made_motion(path, motions, motion_config, SimulationConfig(**variants[0][1]))
+            first = made_motion(path, motions, motion_config, SimulationConfig(**variants[0][1]), git)
             for variant, overrides in variants:
                 execution = first
                 if variant != variants[0][0] and first.motion is not None:

@@ -1,8 +1,8 @@
 """Talos standing on a 10 deg slope in MuJoCo: with MuJoCo's default solver its soft frictional
 contacts let the soles creep downhill under the weight's tangential load (well inside the
 friction cone); the noslip solver after the main one (`SimulationConfig.noslip_iterations`) or
-elliptic cones with frictional constraints harder than the normal ones (`SimulationConfig.cone`,
-`impratio`) hold them, and `simulate` runs both by default."""
+frictional constraints harder than the normal ones (`SimulationConfig.impratio`) hold them, and
+`simulate` runs both by default."""
 
 import dataclasses
 import math
@@ -57,7 +57,7 @@ def test_the_noslip_solver_or_hard_friction_keeps_the_soles_on_a_slope():
     runs = {
         "mujoco's default": mujoco_default,
         "noslip": mujoco_default | {"noslip_iterations": 5},
-        "elliptic, impratio 10": mujoco_default | {"cone": "elliptic", "impratio": 10.0},
+        "impratio 10": mujoco_default | {"impratio": 10.0},
         "simulate's default": {},
     }
     slip = {}

@@ -153,9 +153,10 @@ def sole_push_slip(mesh_contact: str, cone: str, impratio: float) -> float:
 
 def test_a_pushed_sole_holds_on_a_slope_with_the_default_friction_solver():
     config = SimulationConfig()
-    assert sole_push_slip(config.mesh_contact, config.cone, config.impratio) < 2e-4
-    # MuJoCo's default impedance ratio lets the same sole creep within its friction cone
-    assert sole_push_slip("columns", "pyramidal", 1.0) > 1e-3
+    # 0.2 mm in 2 s; with MuJoCo's default impedance ratio the same sole creeps 2.1 mm, its
+    # load within the friction cone
+    assert sole_push_slip(config.mesh_contact, config.cone, config.impratio) < 5e-4
+    assert sole_push_slip("columns", "pyramidal", 1.0) > 1.5e-3
 
 
 def test_bad_physics_settings_are_named():

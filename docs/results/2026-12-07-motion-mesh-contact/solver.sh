@@ -1,20 +1,22 @@
 #!/usr/bin/env bash
 # With execute.sh: the friction solver, and the parts run beside execute.sh's halves.
 #   solver.sh c        A's scenarios after rubbles_stairs_1, last first, in a third process
-#                      (raster_c, columns_c, columns_elliptic_c); execute.sh's `a` then finds
-#                      their motions kept and simulates them again only
-#   solver.sh elliptic HALF   the scenarios of execute.sh's half (a or b) simulated again on
-#                      columns with elliptic friction cones and impratio 10 (columns_elliptic_HALF),
+#                      (raster_c, columns_c, columns_elliptic_c: elliptic cones, impratio 10);
+#                      execute.sh's `a` then finds their motions kept and simulates them only.
+#                      It was stopped during rubbles_stairs_3 (`a` ran that one).
+#   solver.sh final HALF   the scenarios of execute.sh's half (a or b) simulated again with the
+#                      settings kept (columns, pyramidal cones, impratio 10: variant final_HALF)
 #                      from the motions kept in runs/motions_checked; darpa_0's motion is made
-#                      again (this code centres its one-foot posture 54, the only one of these
-#                      plans that it changes)
+#                      again (this code centres its one-foot posture 54, the only posture of these
+#                      plans that it changes: one_foot_fallback.txt)
 #   solver.sh evals    the evaluation scenarios' plans (box terrains, where `mesh_contact`
 #                      changes nothing), made and executed with MuJoCo's default solver (raster)
-#                      and with elliptic cones and impratio 10 (columns_elliptic)
-#   solver.sh combine  every part merged into raster_all, columns (HPP scenes only) and
-#                      columns_elliptic_all
+#                      and with the settings kept (final)
+#   solver.sh combine  every part merged: raster_all (before), final_all (now), and for the HPP
+#                      scenes alone raster, columns, final
 set -euo pipefail
 OUT=docs/results/2026-12-07-motion-mesh-contact
+FINAL='{"mesh_contact": "columns", "cone": "pyramidal", "impratio": 10.0}'
 ELLIPTIC='{"mesh_contact": "columns", "cone": "elliptic", "impratio": 10.0}'
 COLUMNS='{"mesh_contact": "columns", "cone": "pyramidal", "impratio": 1.0}'
 BEFORE='{"mesh_contact": "raster", "cone": "pyramidal", "impratio": 1.0}'
@@ -30,15 +32,15 @@ run() {  # variant, scenarios, SimulationConfig overrides, more arguments
 }
 case "$1" in
     c) run raster_c "$C" "$BEFORE" --also "columns_c=$COLUMNS" --also "columns_elliptic_c=$ELLIPTIC" ;;
-    elliptic)
-        rm -f runs/motions_checked/hpp_darpa_0.*
-        if [ "$2" = a ]; then run columns_elliptic_a "$A" "$ELLIPTIC"; else run columns_elliptic_b "$B" "$ELLIPTIC"; fi ;;
-    evals) run raster_evals_a "$EVAL_A" "$BEFORE" --also "columns_elliptic_evals_a=$ELLIPTIC" &
-           run raster_evals_b "$EVAL_B" "$BEFORE" --also "columns_elliptic_evals_b=$ELLIPTIC"; wait ;;
+    final)
+        if [ "$2" = a ]; then run final_a "$A" "$FINAL"; else rm -f runs/motions_checked/hpp_darpa_0.*; run final_b "$B" "$FINAL"; fi ;;
+    evals) run raster_evals_a "$EVAL_A" "$BEFORE" --also "final_evals_a=$FINAL" &
+           run raster_evals_b "$EVAL_B" "$BEFORE" --also "final_evals_b=$FINAL"; wait ;;
     combine)
-        for v in raster columns_elliptic; do
-            python studies/motion_execution.py --out "$OUT" --combine "${v}_a,${v}_b,${v}_c" --variant "$v"
+        python studies/motion_execution.py --out "$OUT" --combine raster_c,raster_a,raster_b --variant raster
+        python studies/motion_execution.py --out "$OUT" --combine columns_c,columns_a,columns_b --variant columns
+        python studies/motion_execution.py --out "$OUT" --combine final_a,final_b --variant final
+        for v in raster final; do
             python studies/motion_execution.py --out "$OUT" --combine "${v},${v}_evals_a,${v}_evals_b" --variant "${v}_all"
-        done
-        python studies/motion_execution.py --out "$OUT" --combine columns_a,columns_b,columns_c --variant columns ;;
+        done ;;
 esac

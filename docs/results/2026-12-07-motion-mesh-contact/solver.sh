@@ -44,3 +44,9 @@ case "$1" in
             python studies/motion_execution.py --out "$OUT" --combine "${v},${v}_evals_a,${v}_evals_b" --variant "${v}_all"
         done ;;
 esac
+# talos_maze's plan (2145 postures), alone: `solver.sh maze` (variant final_maze)
+if [ "$1" = maze ]; then
+    python studies/motion_execution.py --out "$OUT" --transitions --plans runs/motion_plans_checked \
+        --motions runs/motions_checked --starts 2 --ground-starts 1 --max-plans 0 --max-postures 0 \
+        --variant final_maze --scenarios hpp_talos_maze --simulation-config "$FINAL"
+fi

@@ -1492,8 +1492,9 @@ def make_motion(plan: ContactPlan, config: MotionConfig = MotionConfig(), check:
     the stance sole (`shifted_support`, the shifts from none up; where it cannot, as before),
     and one that still fails, or whose stance sole's centre of pressure comes within
     `MotionConfig.pressure_margin` of its edges, slower (`MotionConfig.slowed_duration`); at
-    most two remakes. Every other phase is made as before (and not sampled again). A one-foot posture centred in its stance sole
-    (`centred_postures`) whose single support cannot be made is taken as the plan has it.
+    most two remakes. Every other phase is made as before (and not sampled again). A one-foot
+    posture centred in its stance sole (`centred_postures`) whose single support cannot be
+    made is taken as the plan has it.
 
     Args:
         plan: the contact plan (at least 2 postures).

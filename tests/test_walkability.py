@@ -182,7 +182,10 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
     """`test_poses_per_terrain` sets the draws of the test terrains and scenes, the held-out
     families have terrains and draws of their own, the fit keeps `poses_per_terrain`, and a test
     pose is the same pose whatever the fit's draws: a build with many small fitting terrains is
-    judged on the same poses as one with a few large ones."""
+    judged on the same poses as one with a few large ones. A build with `footing` writes a model
+    that reads the footing shares at its places."""
+    from leas_jax.env import learned_feasibility as lf
+
     drawn = []
 
     def labels(terrain, poses, cache, workers, generator_config=None):
@@ -214,13 +217,17 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
     drawn.clear()
     wk.build(
         tmp_path / "v.npz",
-        dataclasses.replace(config, terrains_per_family=1, poses_per_terrain=60),
+        dataclasses.replace(config, terrains_per_family=1, poses_per_terrain=60, footing=True),
         scenes=(scene,),
         cache=tmp_path,
         workers=0,
         say=lambda _: None,
     )
     assert np.array_equal(drawn[4][2], first_test), "a test terrain's poses do not depend on the fit's"
+    plain, footing = lf.load_params(tmp_path / "w.npz")[0], lf.load_params(tmp_path / "v.npz")[0]
+    assert "footing" not in plain
+    np.testing.assert_array_equal(np.asarray(footing["footing"]), lf.footing_points(ReachabilityConfig()))
+    assert footing["w0"].shape[0] == plain["w0"].shape[0] + 2 * len(lf.footing_points(ReachabilityConfig()))
 
 
 def test_no_fitting_terrain_is_a_test_terrain():
@@ -266,6 +273,12 @@ def test_the_default_build_is_the_shipped_models_recipe():
     import json
     from pathlib import Path
 
-    shipped = json.loads((Path(__file__).parents[1] / "checkpoints/walkability/walkability.json").read_text())
+    from leas_jax.env import learned_feasibility as lf
+
+    folder = Path(__file__).parents[1] / "checkpoints/walkability"
+    shipped = json.loads((folder / "walkability.json").read_text())
     defaults = json.loads(json.dumps(dataclasses.asdict(wk.WalkabilityConfig())))
-    assert shipped["config"] == defaults
+    # the footing option came after the shipped build: its weights read no footing shares
+    reads_footing = "footing" in lf.load_params(folder / "walkability.npz")[0]
+    assert shipped["config"].get("footing", reads_footing) == reads_footing
+    assert shipped["config"] | {"footing": reads_footing} == defaults

@@ -11,6 +11,8 @@ terrain is `void_height` (the void the boxes stand over).
 
 from __future__ import annotations
 
+import math
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -38,6 +40,9 @@ class Heightfield:
             the void); [1, 1] zeros when the foothold term is disabled (`foothold_spread` None).
         hand_max: [nx, ny] highest terrain point within `hand_radius` of the point; [1, 1]
             zeros when the hands term is disabled (`hand_radius` None).
+        footing: [2, nx, ny] the share of ground within FOOTING_SHARE_RADIUS of the point a
+            sole stands on in static equilibrium, and the share of solid ground there
+            (`footing_rasters`; the walkability model reads both).
         origin: [2] world (x, y) of `heights[0, 0]`.
         resolution: [] cell size (m).
         void_height: [] height outside the grid.
@@ -63,6 +68,7 @@ class Heightfield:
     leg_min: jax.Array
     foothold: jax.Array
     hand_max: jax.Array
+    footing: jax.Array
     origin: jax.Array
     resolution: jax.Array
     void_height: jax.Array
@@ -237,6 +243,74 @@ def foothold_raster(
     return disk_filter(spread, foothold_search / resolution, "min", np.inf).astype(np.float32)
 
 
+# The steepest ground a sole holds in static equilibrium: the contact generator's friction
+# pyramid (`contacts.robot.equilibrium.friction_generators`: 4 edges inscribed in the mu = 0.5
+# cone, oriented along world x and y as hpp-centroidal-dynamics' `Equilibrium` does) carries a
+# tangential load up to mu / sqrt(2) of the normal load along x or y, so a plane z = b x + c y
+# holds a sole when max(|b|, |c|) <= mu / sqrt(2) (19.5 deg along x or y). On the DARPA-style
+# blocks family, terrains whose blocks tilt 19.3 deg or more leave 60-76 % of their poses
+# unwalkable and those at 18.8 deg or less 0-20 % (docs/results/2026-12-07-walkability-footing).
+# tests/test_footing.py checks it against the generator's pyramid.
+FOOTING_SLOPE = 0.5 / math.sqrt(2.0)
+FOOTING_SOLE_RADIUS = 0.06  # m, half-side of the square a sole's plane is fitted on
+FOOTING_UNEVENNESS = 0.015  # m, largest height spread under that square beyond its plane's own
+FOOTING_SHARE_RADIUS = 0.10  # m, the disk a share is taken over (a foot lands anywhere near its place)
+
+
+def _disk_mean(raster: np.ndarray, radius_cells: float) -> np.ndarray:
+    """Mean of `raster` over the disk around every grid point, zero beyond the grid (host)."""
+    r = int(np.floor(radius_cells))
+    k = np.arange(-r, r + 1)
+    disk = (k[:, None] ** 2 + k[None, :] ** 2 <= radius_cells**2).astype(np.float64)
+    return ndimage.correlate(raster.astype(np.float64), disk / disk.sum(), mode="constant", cval=0.0)
+
+
+def footing_rasters(heights: np.ndarray, void_height: float, resolution: float) -> np.ndarray:
+    """Where a sole could stand, as shares of the ground around every grid point (host, NumPy).
+
+    A grid point is *footing* when the square of half-side FOOTING_SOLE_RADIUS around it is
+    solid ground (no void), the least-squares plane z = b x + c y over it holds a sole in
+    static equilibrium (max(|b|, |c|) <= FOOTING_SLOPE) and the heights stray from that plane
+    by at most FOOTING_UNEVENNESS (no edge, step or crack under it).
+
+    Args:
+        heights: [nx, ny] terrain heights (m), world grid.
+        void_height: height of the void (m).
+        resolution: cell size (m).
+
+    Returns:
+        [2, nx, ny] float32: the share of footing points, and the share of solid points,
+        within FOOTING_SHARE_RADIUS of each grid point (zero beyond the grid).
+    """
+    heights = np.asarray(heights, np.float64)
+    solid = heights > void_height + 1e-6
+    half = max(int(round(FOOTING_SOLE_RADIUS / resolution)), 1)
+    size = 2 * half + 1
+    offsets = np.arange(-half, half + 1) * resolution
+    level = np.where(solid, heights, 0.0)
+    # the plane's slopes are separable filters: sum(offset * h) / sum(offset^2) along one
+    # axis, a mean along the other
+    along = offsets / np.sum(offsets**2)
+    b = ndimage.correlate1d(
+        ndimage.uniform_filter1d(level, size, axis=1, mode="nearest"), along, axis=0, mode="nearest"
+    )
+    c = ndimage.correlate1d(
+        ndimage.uniform_filter1d(level, size, axis=0, mode="nearest"), along, axis=1, mode="nearest"
+    )
+    spread = ndimage.maximum_filter(level, size, mode="nearest") - ndimage.minimum_filter(
+        level, size, mode="nearest"
+    )
+    unevenness = spread - (np.abs(b) + np.abs(c)) * 2 * half * resolution
+    square_solid = ndimage.minimum_filter(solid.astype(np.uint8), size, mode="constant", cval=0) > 0
+    footing = (
+        square_solid
+        & (np.maximum(np.abs(b), np.abs(c)) <= FOOTING_SLOPE)
+        & (unevenness <= FOOTING_UNEVENNESS)
+    )
+    radius = FOOTING_SHARE_RADIUS / resolution
+    return np.stack([_disk_mean(footing, radius), _disk_mean(solid, radius)]).astype(np.float32)
+
+
 def _spawn_points(
     heights: np.ndarray,
     trunk_max: np.ndarray,
@@ -346,6 +420,7 @@ def heightfield_from_raster(
         leg_min=f32(leg_min),
         foothold=f32(np.zeros((1, 1)) if foothold is None else foothold),
         hand_max=f32(np.zeros((1, 1)) if hand_max is None else hand_max),
+        footing=f32(footing_rasters(heights, void_height, resolution)),
         origin=f32(origin),
         resolution=f32(resolution),
         void_height=f32(void_height),

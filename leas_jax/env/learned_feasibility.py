@@ -15,6 +15,11 @@ It reads
     boundary instead of learning the whole geometry from a few thousand verdicts (on
     3 200 fresh poses, the patch alone reached 99.0 / 64.7 % on fresh poses where the
     calibrated cylinders give 96.0 / 91.5 %: docs/results/2026-12-01-feasibility);
+  - where the weights hold "footing" points (the walkability model's), the footing shares
+    at each (`field.footing_rasters`: ground a sole stands on in static equilibrium, and
+    solid ground, around each footstep place of the walking guide): the friction limit is
+    the same on every terrain, where the patch's shapes are those of the fitting families
+    (docs/results/2026-12-07-walkability-footing);
 
 standardises them and runs a tanh MLP to one logit. The pose is feasible when the logit
 is at least the stored threshold. Everything, grid included, is data in one dict of
@@ -38,6 +43,7 @@ from leas_jax.env.learned_weights import (  # noqa: F401 (the weights' file API,
     GROUND_RADIUS,
     LAYER_KEYS,
     LearnedParams,
+    feature_count,
     load_params,
     margin_count,
     save_params,
@@ -51,6 +57,7 @@ PATCH_Y = (-0.64, 0.64)
 PATCH_STEP = 0.08  # m; half the 0.04 m of the gradient-boosted reference: 238 points instead of 858
 CLIP = (-1.6, 0.4)  # m, relative heights (the arena's void is 2 m below its ground)
 HEIGHT_CLIP = (0.0, 2.0)  # m, height above the local ground
+FOOTING_X = (0.04, 0.20, 0.36)  # m, root frame: footstep places along the walking truth's 0.36 m guide
 
 
 def patch_grid(x_range=PATCH_X, y_range=PATCH_Y, step: float = PATCH_STEP) -> np.ndarray:
@@ -59,6 +66,14 @@ def patch_grid(x_range=PATCH_X, y_range=PATCH_Y, step: float = PATCH_STEP) -> np
     gy = np.arange(y_range[0], y_range[1] + 1e-9, step)
     px, py = np.meshgrid(gx, gy, indexing="ij")
     return np.stack([px.ravel(), py.ravel()], axis=-1).astype(np.float32)
+
+
+def footing_points(reach: ReachabilityConfig = ReachabilityConfig()) -> np.ndarray:
+    """Root-frame footstep places the footing shares are read at: FOOTING_X on the left leg's
+    line (y = +leg_lateral_offset), then on the right's. Returns [2 * len(FOOTING_X), 2] float32 (m)."""
+    x = np.asarray(FOOTING_X, np.float32)
+    y = np.full_like(x, reach.leg_lateral_offset)
+    return np.concatenate([np.stack([x, y], -1), np.stack([x, -y], -1)]).astype(np.float32)
 
 
 def mirror_index(grid: np.ndarray) -> np.ndarray:
@@ -73,9 +88,12 @@ def mirror_index(grid: np.ndarray) -> np.ndarray:
         raise ValueError("the patch grid is not symmetric in y") from None
 
 
-def feature_mirror_index(grid: np.ndarray, reach: ReachabilityConfig = ReachabilityConfig()) -> np.ndarray:
+def feature_mirror_index(
+    grid: np.ndarray, reach: ReachabilityConfig = ReachabilityConfig(), footing: np.ndarray | None = None
+) -> np.ndarray:
     """[F] index of each feature in the features of the pose's mirror image (terrain reflected
-    across the root's x axis): patch points mirrored, left and right legs and hands swapped."""
+    across the root's x axis): patch points mirrored, left and right legs and hands swapped,
+    footing places (`footing` [K, 2], None: no footing features) mirrored."""
     p = len(grid)
     legs = 2 if reach.leg_forward == 0.0 else 4
     swap = np.arange(legs) ^ 1  # left <-> right, ahead pairs likewise
@@ -84,7 +102,12 @@ def feature_mirror_index(grid: np.ndarray, reach: ReachabilityConfig = Reachabil
     margin = [p + 1] + [base + g * legs + k for g in range(groups) for k in swap]
     if reach.hand_radius is not None:
         margin += [base + groups * legs + 1, base + groups * legs]
-    return np.concatenate([mirror_index(grid), [p], margin]).astype(np.int64)
+    index = [mirror_index(grid), [p], margin]
+    if footing is not None:
+        start = base + margin_count(reach) - 1
+        places = mirror_index(np.asarray(footing))
+        index += [start + places, start + len(places) + places]
+    return np.concatenate(index).astype(np.int64)
 
 
 def raw_features(
@@ -94,6 +117,7 @@ def raw_features(
     ground: jax.Array,
     clip: jax.Array,
     reach: ReachabilityConfig = ReachabilityConfig(),
+    footing: jax.Array | None = None,
 ) -> jax.Array:
     """Unstandardised features of one pose.
 
@@ -104,10 +128,12 @@ def raw_features(
         ground: [G] int, the grid points within GROUND_RADIUS of the root (`ground_index`).
         clip: [2] (lo, hi) of the relative heights (m).
         reach: the cylinders whose margins are read.
+        footing: [K, 2] root-frame footstep places (`footing_points`), or None.
 
     Returns:
-        [P + 1 + M]: terrain height minus z at the patch points (clipped), z minus the
-        local ground (clipped to HEIGHT_CLIP), the M `reachability.margins`.
+        [P + 1 + M (+ 2 K)]: terrain height minus z at the patch points (clipped), z minus the
+        local ground (clipped to HEIGHT_CLIP), the M `reachability.margins` (and the footing
+        share, then the solid share, at each footstep place; zero off the raster).
     """
     x, y = world_xy(pose, grid)
     relative = sample_nearest_xy(field, field.heights, x, y) - pose[2]
@@ -119,13 +145,15 @@ def raw_features(
     above_ground = pose[2] - jnp.max(
         sample_nearest_xy(field, field.heights, ground_x, ground_y), initial=-jnp.inf
     )
-    return jnp.concatenate(
-        [
-            jnp.clip(relative, clip[0], clip[1]),
-            jnp.clip(above_ground, *HEIGHT_CLIP)[None],
-            reachability.margins(field, pose, reach),
-        ]
-    )
+    parts = [
+        jnp.clip(relative, clip[0], clip[1]),
+        jnp.clip(above_ground, *HEIGHT_CLIP)[None],
+        reachability.margins(field, pose, reach),
+    ]
+    if footing is not None:
+        place_x, place_y = world_xy(pose, footing)
+        parts += [sample_nearest_xy(field, share, place_x, place_y, outside=0.0) for share in field.footing]
+    return jnp.concatenate(parts)
 
 
 def features(
@@ -134,8 +162,10 @@ def features(
     pose: jax.Array,
     reach: ReachabilityConfig = ReachabilityConfig(),
 ) -> jax.Array:
-    """[P + 1 + M] raw features of one pose [4] on the params' grid and clip."""
-    return raw_features(field, pose, params["grid"], params["ground_index"], params["clip"], reach)
+    """[F] raw features of one pose [4] on the params' grid, clip and footing places (if any)."""
+    return raw_features(
+        field, pose, params["grid"], params["ground_index"], params["clip"], reach, params.get("footing")
+    )
 
 
 def logit_of_features(params: LearnedParams, x: jax.Array) -> jax.Array:
@@ -173,15 +203,17 @@ def init_params(
     grid: np.ndarray | None = None,
     clip=CLIP,
     reach: ReachabilityConfig = ReachabilityConfig(),
+    footing: np.ndarray | None = None,
 ) -> LearnedParams:
     """Random parameters (Glorot-uniform weights, zero biases, identity standardisation, threshold 0).
 
     Keys and shapes: grid [P, 2], ground_index [G] (derived from the grid), clip [2], mean and
-    std [F] (F = P + 1 + M, M = `margin_count(reach)`), w0 [F, H0], b0 [H0], w1 [H0, H1], b1
-    [H1], w2 [H1, 1], b2 [1], threshold [].
+    std [F] (F = P + 1 + M (+ 2 K), M = `margin_count(reach)`), w0 [F, H0], b0 [H0], w1 [H0,
+    H1], b1 [H1], w2 [H1, 1], b2 [1], threshold []; with `footing` [K, 2] (root-frame footstep
+    places, `footing_points`), "footing" too.
     """
     grid = patch_grid() if grid is None else np.asarray(grid, np.float32)
-    sizes = (len(grid) + 1 + margin_count(reach), *hidden, 1)
+    sizes = (feature_count(grid, reach, footing), *hidden, 1)
     params = {
         "grid": jnp.asarray(grid),
         "clip": jnp.asarray(clip, jnp.float32),
@@ -189,6 +221,8 @@ def init_params(
         "std": jnp.ones(sizes[0]),
         "threshold": jnp.zeros(()),
     }
+    if footing is not None:
+        params["footing"] = jnp.asarray(footing, jnp.float32)
     for layer, (k, (n_in, n_out)) in enumerate(
         zip(jax.random.split(key, 3), zip(sizes[:-1], sizes[1:], strict=True), strict=True)
     ):

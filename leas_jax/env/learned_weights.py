@@ -37,6 +37,12 @@ def margin_count(reach: ReachabilityConfig) -> int:
     )
 
 
+def feature_count(grid, reach: ReachabilityConfig, footing=None) -> int:
+    """F, the number of features the condition reads: patch [P, 2], height above the ground,
+    margins, and two shares per footing place [K, 2] (None: none)."""
+    return len(grid) + 1 + margin_count(reach) + (0 if footing is None else 2 * len(footing))
+
+
 def ground_index(grid) -> np.ndarray:
     """[G] int32, the points of a patch grid [P, 2] (root frame, m) within GROUND_RADIUS of the root."""
     grid = np.asarray(grid)
@@ -77,7 +83,8 @@ def load_params(path: str | Path) -> tuple[LearnedParams, dict]:
     missing = [k for k in needed if k not in arrays]
     if missing:
         raise ValueError(f"{path}: not a learned condition's weights (missing {', '.join(missing)})")
-    params = {k: jnp.asarray(arrays[k], jnp.float32) for k in needed}
+    optional = [k for k in ("footing",) if k in arrays]
+    params = {k: jnp.asarray(arrays[k], jnp.float32) for k in (*needed, *optional)}
     metadata = {k[len("meta_") :]: str(v) for k, v in arrays.items() if k.startswith("meta_")}
     return with_ground_index(params), metadata
 
@@ -94,7 +101,7 @@ def condition_params(config: EnvConfig) -> dict:
         )
     path = resolve_data_path(config.learned_weights)
     params, metadata = load_params(path)
-    features = len(params["grid"]) + 1 + margin_count(config.reachability)
+    features = feature_count(params["grid"], config.reachability, params.get("footing"))
     if params["mean"].shape != (features,):
         raise ValueError(
             f"{path}: the learned condition reads {params['mean'].shape[0]} features, but its patch and "

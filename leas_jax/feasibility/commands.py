@@ -7,13 +7,14 @@ lattice reads (`walkability`, on procedural terrain families).
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from leas_jax.arguments import non_negative_float, non_negative_int, positive_int
 from leas_jax.errors import UsageError
 
 
-def _scenes(patterns: list[str]):
+def scene_terrains(patterns: list[str]):
     """Terrains of the scene files the globs match (sorted), each once; UsageError when a glob
     matches no file."""
     from glob import glob
@@ -102,6 +103,7 @@ def cmd_walkability(args) -> int:
             "held_out_poses_per_terrain",
             "jittered_terrains_per_family",
             "root_height_jitter",
+            "footing",
         )
         if getattr(args, name) is not None
     }
@@ -115,7 +117,7 @@ def cmd_walkability(args) -> int:
         build_seeds(config)
     except ValueError as error:
         raise UsageError(f"--terrains-per-family, --jittered-terrains-per-family: {error}") from None
-    scenes = _scenes(args.scenes or [])
+    scenes = scene_terrains(args.scenes or [])
     report = build(out, config, scenes, cache=Path(args.cache), workers=args.workers)
     print(report_table(report), end="")
     print(
@@ -289,6 +291,13 @@ def _register_walkability(targets) -> None:
         default=None,
         metavar="M",
         help="largest move of a jittered root height from the lattice's, m (default 0.10; 0: no jittered test)",
+    )
+    parser.add_argument(
+        "--footing",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the model reads the footing shares at the guide's footstep places: ground a sole "
+        "stands on within the generator's friction limit (default: the shipped model's, without)",
     )
     parser.add_argument(
         "--scenes", nargs="*", metavar="GLOB", help="terrain files whose poses test the model too"

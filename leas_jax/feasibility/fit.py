@@ -58,9 +58,12 @@ def _features(params, field, poses, reach):
     return jax.vmap(lambda p: lf.features(params, field, p, reach))(poses)
 
 
-def mirrored(x: np.ndarray, grid: np.ndarray, reach: ReachabilityConfig = ReachabilityConfig()) -> np.ndarray:
-    """Features [N, F] of the mirrored poses (terrain reflected across the root's x axis)."""
-    return x[:, lf.feature_mirror_index(np.asarray(grid), reach)]
+def mirrored(
+    x: np.ndarray, grid: np.ndarray, reach: ReachabilityConfig = ReachabilityConfig(), footing=None
+) -> np.ndarray:
+    """Features [N, F] of the mirrored poses (terrain reflected across the root's x axis);
+    `footing`: the features' footing places [K, 2], or None."""
+    return x[:, lf.feature_mirror_index(np.asarray(grid), reach, footing)]
 
 
 def _loss(params, x, y, weight):
@@ -109,6 +112,7 @@ def fit(
     grid: np.ndarray | None = None,
     init: lf.LearnedParams | None = None,
     reach: ReachabilityConfig = ReachabilityConfig(),
+    footing: np.ndarray | None = None,
 ) -> tuple[lf.LearnedParams, dict]:
     """Fit the condition to features x [N, F] (`features_of` with `reach`) and labels y [N] bool.
 
@@ -119,6 +123,8 @@ def fit(
             ignored with `init`, whose grid the features must use.
         init: previous parameters to start from (a refresh: `config.refresh_steps` steps,
             standardisation kept); None: random weights, `config.steps` steps.
+        footing: [K, 2] the features' footing places (`learned_feasibility.footing_points`), or
+            None; ignored with `init`, whose places the features must use.
 
     Returns:
         (params with the threshold set on the poses kept aside, info: poses, aside,
@@ -132,14 +138,16 @@ def fit(
     n_aside = int(round(config.aside_fraction * len(x)))
     aside, kept = order[:n_aside], order[n_aside:]
     if init is None:
-        params = lf.init_params(jax.random.PRNGKey(config.seed), config.hidden, grid, reach=reach)
+        params = lf.init_params(
+            jax.random.PRNGKey(config.seed), config.hidden, grid, reach=reach, footing=footing
+        )
         steps = config.steps
     else:
         params, steps = dict(init), config.refresh_steps
     xt, yt = x[kept], y[kept]
     if config.mirror:
         xt, yt = (
-            np.concatenate([xt, mirrored(xt, np.asarray(params["grid"]), reach)]),
+            np.concatenate([xt, mirrored(xt, np.asarray(params["grid"]), reach, params.get("footing"))]),
             np.concatenate([yt, yt]),
         )
     if init is None:  # standardise on the fitting poses (a refresh keeps the input scale it learned on)

@@ -88,6 +88,13 @@ class WalkabilityConfig:
     held_out_terrains_per_family: int = 30  # seeds HELD_OUT_SEEDS..
     held_out_poses_per_terrain: int = 50
     feature_fraction: float = 0.8  # share of poses drawn over the feature's x band (+-0.5 m)
+    # With `footing` the model reads the footing shares at the guide's footstep places as well
+    # (`learned_feasibility.footing_points`, `field.footing_rasters`): ground a sole stands on
+    # within the generator's friction limit is the same rule on families it never saw, where the
+    # patch's shapes are the fitting families' (docs/results/2026-12-07-walkability-footing). The
+    # shipped model was fitted without them, on labels of the generator before its transition
+    # checks; a model with them needs those labels again (about two hours on 2 cores).
+    footing: bool = False
     target_sensitivity: float = 0.95  # the threshold keeps this share of walkable poses
     nominal_root_height: float = 1.0  # m above the ground (EnvConfig.nominal_root_height)
     crack_width: float = 0.10  # m, `crack_filled_ground`
@@ -545,7 +552,8 @@ def build(
 
     began = time.perf_counter()
     reach = ReachabilityConfig()
-    grid_params = lf.init_params(jax.random.PRNGKey(config.seed), reach=reach)
+    footing = lf.footing_points(reach) if config.footing else None
+    grid_params = lf.init_params(jax.random.PRNGKey(config.seed), reach=reach, footing=footing)
     cache = Path(cache)
     cache.mkdir(parents=True, exist_ok=True)
     seeds = build_seeds(config)
@@ -611,7 +619,7 @@ def build(
         say(f"{scene.name}: {len(part.y)} plausible poses, {int(part.y.sum())} walkable")
         scene_sets.append(part)
     fit_config = FitConfig(target_sensitivity=config.target_sensitivity, seed=config.seed)
-    params, info = fit(train.x, train.y, fit_config, reach=reach)
+    params, info = fit(train.x, train.y, fit_config, reach=reach, footing=footing)
     key = data_key(config, scenes)
     lf.save_params(
         out,

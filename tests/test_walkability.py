@@ -183,7 +183,7 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
     families have terrains and draws of their own, the fit keeps `poses_per_terrain`, and a test
     pose is the same pose whatever the fit's draws: a build with many small fitting terrains is
     judged on the same poses as one with a few large ones. A build with `footing` writes a model
-    that reads the footing shares at its places."""
+    that reads the footing shares at its places, one without it a model that does not."""
     from leas_jax.env import learned_feasibility as lf
 
     drawn = []
@@ -205,6 +205,7 @@ def test_test_terrains_and_scenes_keep_their_own_draws(tmp_path, monkeypatch):
         test_poses_per_terrain=60,
         held_out_terrains_per_family=2,
         held_out_poses_per_terrain=40,
+        footing=False,
     )
     wk.build(tmp_path / "w.npz", config, scenes=(scene,), cache=tmp_path, workers=0, say=lambda _: None)
     counts = [n for _, n, _ in drawn]

@@ -249,7 +249,7 @@ def foothold_raster(
 # tangential load up to mu / sqrt(2) of the normal load along x or y, so a plane z = b x + c y
 # holds a sole when max(|b|, |c|) <= mu / sqrt(2) (19.5 deg along x or y). On the DARPA-style
 # blocks family, terrains whose blocks tilt 19.3 deg or more leave 60-76 % of their poses
-# unwalkable and those at 18.8 deg or less 0-20 % (docs/results/2026-12-07-walkability-footing).
+# unwalkable and those at 18.8 deg or less 2-20 % (docs/results/2026-12-07-walkability-footing).
 # tests/test_footing.py checks it against the generator's pyramid.
 FOOTING_SLOPE = 0.5 / math.sqrt(2.0)
 FOOTING_SOLE_RADIUS = 0.06  # m, half-side of the square a sole's plane is fitted on

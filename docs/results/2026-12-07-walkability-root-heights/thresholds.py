@@ -31,7 +31,8 @@ def main() -> None:
     model = wk.load_walkability(args.model, reach)
     config = wk.WalkabilityConfig()
     seeds = wk.build_seeds(config)
-    grid = lf.init_params(jax.random.PRNGKey(config.seed), reach=reach)
+    # the model's own inputs: with its footing places where it has them
+    grid = lf.init_params(jax.random.PRNGKey(config.seed), reach=reach, footing=model.get("footing"))
     own = float(model["threshold"])
     thresholds = [own if t == "own" else float(t) for t in args.thresholds.split(",")]
     print(

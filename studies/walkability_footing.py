@@ -85,21 +85,10 @@ def main() -> None:
             config.held_out_families, seeds.held_out, config.held_out_poses_per_terrain
         ),
     }
-    scenes = []
-    for k, scene in enumerate(scene_terrains(args.scenes)):
-        scenes.append(
-            wk.labelled_terrain(
-                scene,
-                scene.name,
-                config.test_poses_per_terrain,
-                wk.scene_seed(config, k),
-                config,
-                cache,
-                args.workers,
-                template,
-                band=None,
-            )
-        )
+    scenes = [
+        wk.labelled_scene(scene, k, config, cache, args.workers, template)
+        for k, scene in enumerate(scene_terrains(args.scenes))
+    ]
     if scenes:
         splits["hpp-environments scenes"] = wk.concatenate(scenes)
     footing_columns = 2 * len(places)

@@ -360,6 +360,22 @@ def labelled_terrain(
     return LabelledSet(x, labels, cylinders, np.full(len(poses), group))
 
 
+def labelled_scene(scene, index: int, config, cache, workers, grid_params) -> LabelledSet:
+    """`LabelledSet` of the `index`-th scene of a build: `test_poses_per_terrain` draws anywhere
+    on it, seeded by `scene_seed`."""
+    return labelled_terrain(
+        scene,
+        scene.name,
+        config.test_poses_per_terrain,
+        scene_seed(config, index),
+        config,
+        cache,
+        workers,
+        grid_params,
+        band=None,
+    )
+
+
 def concatenate(sets) -> LabelledSet:
     """One `LabelledSet` of several."""
     return LabelledSet(
@@ -606,17 +622,7 @@ def build(
     )
     scene_sets = []
     for k, scene in enumerate(scenes):
-        part = labelled_terrain(
-            scene,
-            scene.name,
-            config.test_poses_per_terrain,
-            scene_seed(config, k),
-            config,
-            cache,
-            workers,
-            grid_params,
-            band=None,
-        )
+        part = labelled_scene(scene, k, config, cache, workers, grid_params)
         say(f"{scene.name}: {len(part.y)} plausible poses, {int(part.y.sum())} walkable")
         scene_sets.append(part)
     fit_config = FitConfig(target_sensitivity=config.target_sensitivity, seed=config.seed)

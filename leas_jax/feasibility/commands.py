@@ -297,7 +297,7 @@ def _register_walkability(targets) -> None:
         action=argparse.BooleanOptionalAction,
         default=None,
         help="the model reads the footing shares at the guide's footstep places: ground a sole "
-        "stands on within the generator's friction limit (default: the shipped model's, without)",
+        "stands on within the generator's friction limit (default: the shipped model's, with)",
     )
     parser.add_argument(
         "--scenes", nargs="*", metavar="GLOB", help="terrain files whose poses test the model too"

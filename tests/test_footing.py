@@ -122,9 +122,9 @@ def test_the_model_reads_footing_at_the_guides_footstep_places():
 
 
 def test_footing_weights_round_trip_and_drive_the_env(tmp_path):
-    """Weights with footing places keep them through the file and the env's condition reads
-    them (a model that refuses every pose ends the first step; one whose every weight is zero
-    but for a footing share's accepts flat ground)."""
+    """Weights with footing places keep them through the file, and the env's `walkability`
+    condition runs on them: a model whose threshold refuses every pose ends the first step, one
+    whose threshold accepts every pose does not."""
     reach = TRAINING_ENV.reachability
     places = lf.footing_points(reach)
     params = lf.init_params(jax.random.PRNGKey(1), hidden=(8, 4), reach=reach, footing=places)

@@ -92,7 +92,7 @@ def cmd_walkability(args) -> int:
     unknown = [f for f in held if f not in FAMILIES]
     if unknown:
         raise UsageError(f"--held-out: unknown families {', '.join(unknown)} (known: {', '.join(FAMILIES)})")
-    sizes = {
+    given = {
         name: getattr(args, name)
         for name in (
             "terrains_per_family",
@@ -111,7 +111,7 @@ def cmd_walkability(args) -> int:
         WalkabilityConfig(),
         train_families=tuple(f for f in FAMILIES if f not in held),
         held_out_families=held,
-        **sizes,
+        **given,
     )
     try:
         build_seeds(config)

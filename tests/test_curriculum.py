@@ -74,6 +74,19 @@ def test_family_draws_are_seeded_and_every_family_loads():
     assert set(FAMILIES) < set(ALL_FAMILIES)
 
 
+@pytest.mark.parametrize("difficulty", [None, 0.0, 0.5, 1.0])
+def test_stepping_stones_lie_one_gap_from_the_ground_on_either_side(difficulty):
+    for seed in range(6):
+        boxes = _boxes("stones", seed, difficulty)
+        grounds = [b for b in boxes if b["size"][1] == pytest.approx(3.0)]
+        stones = [b for b in boxes if b["size"][1] < 3.0]
+        before, after = sorted(grounds, key=lambda b: b["center"][0])
+        near = min(b["center"][0] - b["size"][0] / 2 for b in stones)
+        far = max(b["center"][0] + b["size"][0] / 2 for b in stones)
+        gap = near - (before["center"][0] + before["size"][0] / 2)
+        assert (after["center"][0] - after["size"][0] / 2) - far == pytest.approx(gap, abs=1e-3)
+
+
 def test_a_difficulty_outside_the_unit_interval_is_refused():
     with pytest.raises(ValueError, match="difficulty"):
         family_boxes("rubble", 0, 1.5)
@@ -94,6 +107,47 @@ def test_a_curriculum_arena_lays_rows_of_difficulty_and_columns_of_families():
     assert widths[0] < widths[1] < widths[2]
     # the flat column is solid everywhere
     assert not void[:, (ys > 0.5) & (ys < 2.5)].any()
+
+
+def test_a_familys_ceiling_scales_its_rows_difficulty():
+    full = loads_terrain(curriculum_terrain(3, levels=3, families=("flat", "gaps")))
+    text = curriculum_terrain(3, levels=3, families=("flat", "gaps"), ceilings={"gaps": 0.5})
+    capped = loads_terrain(text)
+    assert "# Top row's difficulty of gaps: 0.5 of its range." in text
+
+    def widths(terrain):
+        void = terrain.raster() < terrain.void_height + 1e-6
+        xs, ys = terrain.grid_axes()
+        rows = [(xs >= level * 6) & (xs < level * 6 + 6) for level in range(3)]
+        return [void[np.ix_(r, (ys > 4.0) & (ys < 5.0))].all(axis=1).sum() for r in rows]
+
+    full_widths, capped_widths = widths(full), widths(capped)
+    assert capped_widths[0] == full_widths[0]  # row 0 is difficulty 0 either way
+    assert capped_widths[0] < capped_widths[2] < full_widths[2]
+    # the top row of the capped arena is the middle row's difficulty of the full one (same draws
+    # but for the tile seed: the width within the difficulty jitter's spread)
+    assert abs(capped_widths[2] - full_widths[1]) <= 0.1 * 0.75 / 0.02 + 1
+
+
+@pytest.mark.parametrize("ceilings", [{"lava": 0.5}, {"gaps": 1.5}, {"gaps": -0.1}])
+def test_a_bad_ceiling_is_refused(ceilings):
+    with pytest.raises(ValueError, match="ceilings"):
+        curriculum_terrain(0, levels=2, families=("gaps",), ceilings=ceilings)
+
+
+def test_the_passability_sweep_lets_level_ground_through_and_finds_the_ceiling():
+    import sys
+
+    sys.path.insert(0, str(TERRAINS.parent / "studies"))
+    import curriculum_passability
+
+    assert curriculum_passability.ceiling([0.0, 0.5, 1.0], [1.0, 0.4, 0.9], 0.5) == 0.0
+    assert curriculum_passability.ceiling([0.0, 0.5, 1.0], [1.0, 0.6, 0.4], 0.5) == 0.5
+    config = preset("quick").env  # the reachability cylinders: a 0.8 m gap fails, level ground passes
+    shares = curriculum_passability.passability(config, levels=2, seed=0, lines=2)
+    assert set(shares) == set(curriculum_passability.CROSSING)
+    assert shares["gaps"] == [1.0, 0.0]
+    assert shares["stairs"][0] == 1.0
 
 
 def test_the_committed_curriculum_arena_is_the_generated_one():
@@ -243,6 +297,9 @@ def test_the_condition_threshold_moves_the_networks_boundary_and_none_keeps_the_
 def test_the_generalist_preset_trains_on_the_curriculum_with_the_walkability_model():
     config = preset("generalist")
     assert config.env.condition == "walkability"
+    # the direction term weighs 4 (standing still costs 0.36 a step), every other term is quick's
+    quick = preset("quick").env.rewards
+    assert config.env.rewards == dataclasses.replace(quick, direction=4.0 * quick.direction)
     assert load_terrain(config.terrain_path()).curriculum is not None
     assert TrainConfig.from_dict(config.to_dict()) == config
     planner = preset("generalist", mode="planner")  # `leas run --preset generalist`'s fine-tuning

@@ -12,7 +12,8 @@ labels hold ground the generator does not walk as well as ground it does:
   - stairs: 2-4 steps up with 0.05-0.30 m risers and 0.25-0.35 m treads, a 0.6 m landing,
     the same steps down;
   - narrow: a beam or narrow stairs 0.2-0.6 m wide over the void between two platforms;
-  - stones: stepping stones 0.2-0.45 m square, 0.05-0.50 m apart over the void, +-0.10 m high;
+  - stones: stepping stones 0.2-0.45 m square, 0.05-0.50 m apart over the void (and from the
+    ground on either side), +-0.10 m high;
   - gaps: a 0.05-0.80 m gap over the void across the whole width;
   - slopes: a ramp 5-40 deg up (beyond about 30 deg it leaves the friction cone of the
     generator's feet), a landing, a step of up to 0.15 m down to the ground beyond;
@@ -155,10 +156,12 @@ def _narrow(rng) -> list[str]:
 
 
 def _stones(rng) -> list[str]:
-    boxes = _ground()
     side, gap = rng.param(0.45, 0.2, easy=0.6), rng.param(0.05, 0.50, easy=0.02)  # smaller stones, wider gaps
     pitch = side + gap
-    for x in np.arange(FEATURE_X[0] + gap + side / 2, FEATURE_X[1] - side / 2, pitch):
+    columns = np.arange(FEATURE_X[0] + gap + side / 2, FEATURE_X[1] - side / 2, pitch)
+    # the ground resumes `gap` after the last column of stones, as it ends `gap` before the first
+    boxes = _ground(after=columns[-1] + side / 2 + gap)
+    for x in columns:
         for y in np.arange(side / 2 + rng.uniform(0.0, pitch), SIZE[1] - side / 2, pitch):
             boxes.append(
                 _slab(

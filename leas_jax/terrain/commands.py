@@ -49,6 +49,15 @@ def register(subparsers) -> None:
         default=None,
         help="comma-separated families of the columns (default: all ten, flat first)",
     )
+    curriculum.add_argument(
+        "--ceiling",
+        action="append",
+        default=[],
+        metavar="FAMILY=D",
+        help="the top row of FAMILY at difficulty D in [0, 1] of its range instead of 1 (repeatable; "
+        "studies/curriculum_passability.py measures where the training termination stops every "
+        "straight walk)",
+    )
     curriculum.add_argument("--out", metavar="FILE", help="output TOML file (default: stdout)")
     curriculum.set_defaults(func=cmd_curriculum)
 
@@ -112,8 +121,26 @@ def cmd_curriculum(args: argparse.Namespace) -> None:
                 f"terrain curriculum: --families {args.families}: unknown {', '.join(unknown) or 'empty list'} "
                 f"(known: {', '.join(ALL_FAMILIES)})"
             )
-    text = curriculum_terrain(args.seed, levels, families)
+    text = curriculum_terrain(args.seed, levels, families, ceilings=_ceilings(args.ceiling, families))
     _emit(text, args.out)
+
+
+def _ceilings(items: list[str], families) -> dict:
+    """{family: difficulty} of `--ceiling FAMILY=D` arguments; UsageError naming a bad one."""
+    ceilings = {}
+    for item in items:
+        family, _, value = item.partition("=")
+        try:
+            ceiling = float(value)
+        except ValueError:
+            ceiling = None
+        if family not in families or ceiling is None or not 0.0 <= ceiling <= 1.0:
+            raise UsageError(
+                f"terrain curriculum: --ceiling {item}: expected FAMILY=D with FAMILY one of the arena's "
+                f"columns ({', '.join(families)}) and D in [0, 1]"
+            )
+        ceilings[family] = ceiling
+    return ceilings
 
 
 def cmd_show(args: argparse.Namespace) -> None:

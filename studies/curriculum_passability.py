@@ -70,7 +70,7 @@ def passability(config, levels: int, seed: int, lines: int) -> dict:
     from leas_jax.terrain import loads_terrain
     from leas_jax.terrain.curriculum import curriculum_terrain
 
-    terrain = loads_terrain(curriculum_terrain(seed, levels=levels, families=CROSSING))
+    terrain = loads_terrain(curriculum_terrain(seed, levels=levels, families=CROSSING, ceilings={}))
     field = heightfield_from_terrain(terrain, config)
     length, width = terrain.curriculum.tile
     judge = jax.jit(lambda f, poses: jax.vmap(lambda pose: condition.valid(f, pose, config))(poses).all())

@@ -54,9 +54,9 @@ def register(subparsers) -> None:
         action="append",
         default=[],
         metavar="FAMILY=D",
-        help="the top row of FAMILY at difficulty D in [0, 1] of its range instead of 1 (repeatable; "
-        "studies/curriculum_passability.py measures where the training termination stops every "
-        "straight walk)",
+        help="the top row of FAMILY at difficulty D in [0, 1] of its range (repeatable; default: "
+        "where the generalist preset's termination still lets straight walks across, "
+        "CURRICULUM_CEILINGS; FAMILY=1 for its whole range)",
     )
     curriculum.add_argument("--out", metavar="FILE", help="output TOML file (default: stdout)")
     curriculum.set_defaults(func=cmd_curriculum)
@@ -104,7 +104,12 @@ def cmd_generate(args: argparse.Namespace) -> None:
 
 def cmd_curriculum(args: argparse.Namespace) -> None:
     """Write the curriculum arena of `args.seed` to `args.out` (or stdout)."""
-    from leas_jax.terrain.curriculum import CURRICULUM_FAMILIES, CURRICULUM_LEVELS, curriculum_terrain
+    from leas_jax.terrain.curriculum import (
+        CURRICULUM_CEILINGS,
+        CURRICULUM_FAMILIES,
+        CURRICULUM_LEVELS,
+        curriculum_terrain,
+    )
     from leas_jax.terrain.families import ALL_FAMILIES
 
     if args.seed < 0:
@@ -121,7 +126,8 @@ def cmd_curriculum(args: argparse.Namespace) -> None:
                 f"terrain curriculum: --families {args.families}: unknown {', '.join(unknown) or 'empty list'} "
                 f"(known: {', '.join(ALL_FAMILIES)})"
             )
-    text = curriculum_terrain(args.seed, levels, families, ceilings=_ceilings(args.ceiling, families))
+    ceilings = {**CURRICULUM_CEILINGS, **_ceilings(args.ceiling, families)}
+    text = curriculum_terrain(args.seed, levels, families, ceilings=ceilings)
     _emit(text, args.out)
 
 

@@ -32,6 +32,28 @@ CURRICULUM_FAMILIES = (
     "holes",
 )
 CURRICULUM_LEVELS = 8  # rows: 8 x 6 m along x; a 400-step episode at 0.18 m/s walks 7.2 m
+# The top row's difficulty of each family that the `generalist` preset's termination (the
+# walkability model at logit -7 and the plausible cylinders) lets a straight walk cross: the highest
+# difficulty up to which at least half the straight walks across the feature pass it
+# (studies/curriculum_passability.py, 4 arena seeds, 10 walks per tile, difficulty steps of 0.1;
+# docs/results/2026-12-07-curriculum-tiles). Past it an env promoted to the row meets a tile no
+# policy crosses without ending its episode, and the policy learns to stop before the family's
+# features: on the whole ranges a curriculum policy crossed no stairs tile above 0.07 m risers and
+# no rubble tile but the level one, and climbed no HPP stairs; on these it climbs the evaluation
+# and HPP stairs and crosses the HPP rubble (same folder). Stairs top at 0.11 m risers, slopes at
+# 16 deg, blocks at 0.15 m and 10 deg, beams at 0.80 m wide; gaps and stepping stones at 0
+# (hairline cracks): a gap wider than the leg disks' 0.10 m puts both under the root over the void
+# at some pose of any walk, and rubble at 0 (level tiles), past which the model refuses most walks.
+# Families not named keep their whole range (flat, clutter and holes are walked round, not across).
+CURRICULUM_CEILINGS = {
+    "slopes": 0.4,
+    "rubble": 0.0,
+    "blocks": 0.4,
+    "stairs": 0.3,
+    "narrow": 0.4,
+    "stones": 0.0,
+    "gaps": 0.0,
+}
 
 
 def _shifted(box: dict, dx: float, dy: float) -> str:
@@ -58,7 +80,7 @@ def curriculum_terrain(
     levels: int = CURRICULUM_LEVELS,
     families=CURRICULUM_FAMILIES,
     resolution: float = 0.02,
-    ceilings: dict | None = None,
+    ceilings: dict = CURRICULUM_CEILINGS,
 ) -> str:
     """TOML text of a curriculum arena drawn from `seed` (deterministic).
 
@@ -69,7 +91,7 @@ def curriculum_terrain(
         families: the family of each column along y (`families.ALL_FAMILIES`).
         resolution: heightfield cell size (m).
         ceilings: {family: the top row's difficulty in [0, 1]}; a family not named keeps 1.0
-            (its whole range). None: every family's whole range.
+            (its whole range); {}: every family's whole range.
 
     Returns:
         The terrain file's text: levels x 6 m by len(families) x 3 m of boxes over the void at
@@ -82,12 +104,13 @@ def curriculum_terrain(
         raise ValueError(f"seed must be >= 0, got {seed}")
     if levels < 1:
         raise ValueError(f"levels must be >= 1, got {levels}")
-    ceilings = dict(ceilings or {})
+    ceilings = dict(ceilings)
     bad = {f: c for f, c in ceilings.items() if f not in ALL_FAMILIES or not 0.0 <= c <= 1.0}
     if bad:
         raise ValueError(
             f"ceilings {bad}: each must name a family of {', '.join(ALL_FAMILIES)} and lie in [0, 1]"
         )
+    ceilings = {f: c for f, c in ceilings.items() if f in families}
     unknown = [f for f in families if f not in ALL_FAMILIES]
     if unknown or not families:
         raise ValueError(f"unknown terrain families {unknown}: expected some of {', '.join(ALL_FAMILIES)}")

@@ -277,19 +277,8 @@ QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.
 # threshold is -7 by the same rule, ending none of them, where the model keeps 99.6 % of the
 # walkable test poses at jittered heights and refuses 36.1 % of the others
 # (docs/results/2026-12-07-walkability-footing).
-# The direction term weighs 4 instead of the paper's 1. Trained at -7 with the paper's weight, a
-# curriculum policy still reaches no evaluation stairs target most of the time, and on the
-# curriculum's own tiles it stops before features it could cross: it crosses the stairs tiles of
-# 0.03-0.07 m risers and no higher one, and ends neither valid past them nor invalid on them, just
-# short (docs/results/2026-12-07-curriculum-tiles, studies/curriculum_tiles.py). Standing still costs
-# the direction term (0.18 / 0.6)^2 = 0.09 a step against the alive term's 1, so stopping pays
-# wherever a crossing ends one episode in ten. At weight 4 it costs 0.36: the same seed crosses
-# stairs tiles to 0.15 m risers, climbs eval_stairs, eval_stairs_side, the circuit and the HPP
-# stairs from 10 of 10 starts, and walks 0.7-0.8 m further per episode on every arena it never
-# trained on (same folder, three seeds).
 GENERALIST_ENV = dataclasses.replace(
     QUICK_ENV,
-    rewards=dataclasses.replace(QUICK_ENV.rewards, direction=4.0),
     condition="walkability",
     learned_weights="checkpoints/walkability/walkability.npz",
     condition_threshold=-7.0,

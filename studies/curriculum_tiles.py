@@ -132,7 +132,7 @@ def plot(results: dict, path: Path) -> None:
         for (i, j), value in np.ndenumerate(grid):
             ax.text(j, i, f"{100 * value:.0f}", ha="center", va="center", fontsize=7, color="w")
     fig.colorbar(image, ax=axes[0].tolist(), label="tile crossed")
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=70)
     plt.close(fig)
 
 
@@ -182,7 +182,7 @@ def main() -> None:
     results["machine"] = machine()
     store = out / "curriculum_tiles.json"
     tmp = store.with_suffix(".tmp")
-    tmp.write_text(json.dumps(results, indent=1) + "\n")
+    tmp.write_text(json.dumps(results, separators=(",", ":")) + "\n")  # compact: one cell per tile and policy
     tmp.replace(store)
     (out / "curriculum_tiles.md").write_text(markdown(results))
     plot(results, out / "curriculum_tiles.png")

@@ -252,8 +252,9 @@ QUICK_ENV = dataclasses.replace(TRAINING_ENV, rewards=RewardWeights(clearance=1.
 
 # The `generalist` preset: 80 M steps, `quick`'s reward terms and clearance term on a curriculum
 # arena (`terrains/curriculum_arena.toml`, `leas terrain curriculum`: 8 rows of difficulty x 10
-# terrain families, envs moved between rows as legged_gym's terrain levels move them,
-# `EnvConfig.curriculum`), terminating on the walkability model of rough ground (fitted on the
+# terrain families, each family's rows stopping where this termination still lets a walk across,
+# `curriculum.CURRICULUM_CEILINGS`; envs moved between rows as legged_gym's terrain levels move
+# them, `EnvConfig.curriculum`), terminating on the walkability model of rough ground (fitted on the
 # same families: `leas feasibility walkability`) instead of the arena-fitted condition. The
 # reward terms are `quick`'s. Measured (docs/results/2026-12-07-generalist-recipe, one to three
 # seeds each): without the clearance term, or with the `paper` preset's 10 epochs as well, a policy

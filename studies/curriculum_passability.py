@@ -11,8 +11,8 @@ the plausible cylinders):
     range, difficulty k / (levels - 1)), for each of `--seeds` arena seeds;
   - per tile, `--lines` straight walks along +x from 0.5 to 5.5 m into the tile (flat ground
     before and after every feature), 0.018 m apart (0.1 s at 0.18 m/s), heading +x, at lateral
-    offsets evenly spread over +-0.9 m of the tile's centre line (+-0.02 m on the narrow family,
-    whose beam or stairs lie on that line); the root at the nominal height over the mean of
+    offsets evenly spread over +-0.9 m of the tile's centre line (+-0.02 m on the narrow and beams
+    families, whose beam or stairs lie on that line); the root at the nominal height over the mean of
     the solid terrain within 0.1 m (the void of a crack or a gap does not pull it down);
   - a walk passes when every pose of it passes the condition.
 
@@ -36,9 +36,9 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-CROSSING = ("slopes", "rubble", "blocks", "stairs", "narrow", "stones", "gaps")
+CROSSING = ("slopes", "rubble", "blocks", "stairs", "narrow", "stones", "gaps", "beams")  # append only: a column seeds its tiles
 STEP = 0.018  # m between poses of a walk (0.1 s at the target speed)
-SPREAD = {"narrow": 0.02}  # m, half-spread of the walks' lateral offsets; others HALF_SPREAD
+SPREAD = {"narrow": 0.02, "beams": 0.02}  # m, half-spread of the walks' lateral offsets; others HALF_SPREAD
 HALF_SPREAD = 0.9
 SOLID_BELOW = -1.0  # m: heights below this are the void (the arena's void lies at -2 m)
 

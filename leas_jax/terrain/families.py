@@ -19,9 +19,11 @@ labels hold ground the generator does not walk as well as ground it does:
     generator's feet), a landing, a step of up to 0.15 m down to the ground beyond;
   - clutter: flat ground with 4-10 pillars and walls 0.1-0.5 m wide and 0.05-1.5 m high.
 
-Two more families serve the training curriculum (`leas_jax.terrain.curriculum`) and stay out
+Three more families serve the training curriculum (`leas_jax.terrain.curriculum`) and stay out
 of the walkability model's data (`FAMILIES`): holes (a round hole in flat ground, 0.2-1.6 m
-across) and flat ground.
+across), flat ground, and beams (the narrow family's beam alone, 0.2-0.6 m wide at ground level
+over the void, so that a curriculum may grow a beam narrower without growing narrow stairs'
+risers with it).
 
 Drawn without a `difficulty`, a family's parameters are uniform over its ranges (the
 walkability model's data). With a difficulty d in [0, 1] (the curriculum's rows), each
@@ -40,7 +42,7 @@ import math
 import numpy as np
 
 FAMILIES = ("rubble", "blocks", "stairs", "narrow", "stones", "gaps", "slopes", "clutter")
-CURRICULUM_ONLY = ("holes", "flat")  # families of the training curriculum alone
+CURRICULUM_ONLY = ("holes", "flat", "beams")  # families of the training curriculum alone
 ALL_FAMILIES = FAMILIES + CURRICULUM_ONLY  # the order seeds each family's draws: append only
 DIFFICULTY_JITTER = 0.05  # +- spread of a difficulty parameter's quantile around d
 SIZE = (6.0, 3.0)  # m, x and y extent of every family terrain
@@ -146,13 +148,27 @@ def _stairs(rng) -> list[str]:
     return _ground(after=end) + [_slab(x0, x1, top) for x0, x1, top in tops]
 
 
-def _narrow(rng) -> list[str]:
-    width = rng.param(0.6, 0.2, easy=1.2)  # narrower is harder
+def _beam_width(rng) -> float:
+    return rng.param(0.6, 0.2, easy=1.2)  # narrower is harder
+
+
+def _beam(width: float) -> list[str]:
+    """A beam of `width` at ground level over the void between the grounds, on the centre line."""
     y0 = SIZE[1] / 2 - width / 2
-    if rng.uniform() < 0.5:  # a beam at ground level
-        return _ground() + [_slab(FEATURE_X[0], FEATURE_X[1], 0.0, y0, y0 + width)]
+    return _ground() + [_slab(FEATURE_X[0], FEATURE_X[1], 0.0, y0, y0 + width)]
+
+
+def _narrow(rng) -> list[str]:
+    width = _beam_width(rng)
+    if rng.uniform() < 0.5:
+        return _beam(width)
+    y0 = SIZE[1] / 2 - width / 2
     tops, end = _stair_tops(rng)  # narrow stairs
     return _ground(after=end) + [_slab(x0, x1, top, y0, y0 + width) for x0, x1, top in tops]
+
+
+def _beams(rng) -> list[str]:
+    return _beam(_beam_width(rng))
 
 
 def _stones(rng) -> list[str]:
@@ -235,6 +251,7 @@ _BUILDERS = {
     "clutter": _clutter,
     "holes": _holes,
     "flat": _flat,
+    "beams": _beams,
 }
 
 

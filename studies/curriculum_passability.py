@@ -28,15 +28,24 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
-import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-CROSSING = ("slopes", "rubble", "blocks", "stairs", "narrow", "stones", "gaps", "beams")  # append only: a column seeds its tiles
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from generalist import machine  # noqa: E402 (the curriculum study's)
+
+CROSSING = (
+    "slopes",
+    "rubble",
+    "blocks",
+    "stairs",
+    "narrow",
+    "stones",
+    "gaps",
+    "beams",
+)  # append only: a column seeds its tiles
 STEP = 0.018  # m between poses of a walk (0.1 s at the target speed)
 SPREAD = {"narrow": 0.02, "beams": 0.02}  # m, half-spread of the walks' lateral offsets; others HALF_SPREAD
 HALF_SPREAD = 0.9
@@ -142,7 +151,6 @@ def main() -> None:
     per_seed = [passability(config, args.levels, seed, args.lines) for seed in seeds]
     shares = {f: np.mean([s[f] for s in per_seed], axis=0).tolist() for f in CROSSING}
     difficulties = [k / (args.levels - 1) for k in range(args.levels)]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
     results = {
         "condition": f"`{args.preset}` preset: {config.condition}, threshold {config.condition_threshold}, "
         f"weights {config.learned_weights}",
@@ -152,12 +160,7 @@ def main() -> None:
         "difficulties": difficulties,
         "shares": shares,
         "ceilings": {f: ceiling(difficulties, shares[f], args.pass_share) for f in CROSSING},
-        "machine": {
-            "machine": platform.processor() or platform.machine(),
-            "cpus": os.cpu_count(),
-            "load": os.getloadavg()[0],
-            "commit": commit.stdout.strip(),
-        },
+        "machine": machine(),
     }
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -19,14 +19,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
-import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from leas_jax.stats import wilson
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from generalist import machine  # noqa: E402 (the curriculum study's)
 
 ROOT = Path(__file__).resolve().parents[1]
 START_X = 0.5  # m into the tile: flat ground for every family (features begin at 2.0 m)
@@ -134,16 +135,6 @@ def plot(results: dict, path: Path) -> None:
     fig.colorbar(image, ax=axes[0].tolist(), label="tile crossed")
     fig.savefig(path, dpi=70)
     plt.close(fig)
-
-
-def machine() -> dict:
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
-    return {
-        "machine": platform.processor() or platform.machine(),
-        "cpus": os.cpu_count(),
-        "load": os.getloadavg()[0],
-        "commit": commit.stdout.strip(),
-    }
 
 
 def main() -> None:

@@ -395,3 +395,37 @@ def test_the_generalist_study_tabulates_pooled_coverage_with_intervals():
     text = generalist.markdown(results)
     assert "| random_10x10_V5 | 90.6 [81.0, 95.6] (n 64) | 2.50 |" in text
     assert "| eval_stairs | 95.0 [76.4, 99.1] (99) |" in text
+
+
+def test_the_tiles_study_crosses_each_tile_from_its_flat_ground(tmp_path):
+    import sys
+
+    sys.path.insert(0, str(TERRAINS.parent / "studies"))
+    import curriculum_tiles
+
+    from leas_jax.training.policy import load_policy
+
+    starts = curriculum_tiles.tile_starts(1, 2, (6.0, 3.0), (0.0, 0.0), 50, seed=0)
+    assert np.allclose(starts[:, 0], 6.5) and (np.abs(starts[:, 1] - 7.5) <= 0.9).all()
+    assert (np.abs(starts[:, 2]) <= 0.3).all()
+    np.testing.assert_array_equal(
+        starts, curriculum_tiles.tile_starts(1, 2, (6.0, 3.0), (0.0, 0.0), 50, seed=0)
+    )
+    # a 2-row arena of flat ground and gaps: the shipped policy crosses the flat tiles
+    terrain = loads_terrain(curriculum_terrain(0, levels=2, families=("flat", "gaps"), ceilings={}))
+    table = curriculum_tiles.cross_tiles(
+        load_policy(TERRAINS.parent / "checkpoints/leas_talos"), terrain, starts_per_tile=3, seed=0, steps=400
+    )
+    assert [cell["row"] for cell in table["flat"]] == [0, 1]
+    assert all(cell["reached"] == 3 for cell in table["flat"])
+    gap = table["gaps"][1]  # a 0.80 m gap over the void: no policy crosses it under its condition
+    assert gap["reached"] == 0 and gap["reached"] + gap["invalid"] + gap["short"] == 3
+    results = {
+        "terrain": "t",
+        "starts": 3,
+        "seed": 0,
+        "steps": 400,
+        "runs": {"p": "run"},
+        "policies": {"p": table},
+    }
+    assert "| flat | 100 [44, 100] (0) | 100 [44, 100] (0) |" in curriculum_tiles.markdown(results)

@@ -23,6 +23,7 @@ RECIPES = {
     "whole ranges, the paper's reward": ["generalist_t7_s0"],
     "whole ranges, direction weight 4": ["direction_x4_s0"],
     "ceilings (the preset)": ["ceilings_s0", "ceilings_s1", "ceilings_s2"],
+    "ceilings, beams column": ["beams_s0"],
 }
 
 

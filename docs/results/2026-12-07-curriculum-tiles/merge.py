@@ -45,9 +45,10 @@ def pooled(merged: dict, labels: list[str]) -> dict:
     return {"arenas": arenas, "scenarios": scenarios}
 
 
-def recipes_markdown(merged: dict) -> str:
+def recipes_markdown(merged: dict, recipes: dict = RECIPES) -> str:
+    """recipes.md: `recipes` ({name: [policy labels]}) with their seeds pooled."""
     present = {
-        name: [label for label in labels if label in merged["policies"]] for name, labels in RECIPES.items()
+        name: [label for label in labels if label in merged["policies"]] for name, labels in recipes.items()
     }
     present = {name: labels for name, labels in present.items() if labels}
     tables = {name: pooled(merged, labels) for name, labels in present.items()}
@@ -90,7 +91,9 @@ def recipes_markdown(merged: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main() -> None:
+def merged_results(folder: Path = HERE) -> dict:
+    """The paper-arena policy's row of `../2026-12-06-generalist` and every
+    `<folder>/*/generalist.json`, merged into one `studies/generalist.py` results dict."""
     earlier = json.loads(EARLIER.read_text())
     merged = {
         "policies": {},
@@ -100,11 +103,16 @@ def main() -> None:
     }
     for key in ("policies", "arenas", "scenarios"):
         merged[key]["paper_arena"] = earlier[key]["paper_arena"]
-    for path in sorted(HERE.glob("*/generalist.json")):
+    for path in sorted(folder.glob("*/generalist.json")):
         results = json.loads(path.read_text())
         for key in ("policies", "arenas", "scenarios"):
             merged[key].update(results.get(key, {}))
         merged["machine"][path.parent.name] = results.get("machine")
+    return merged
+
+
+def main() -> None:
+    merged = merged_results()
     (HERE / "generalist.json").write_text(json.dumps(merged, indent=1) + "\n")
     (HERE / "generalist.md").write_text(generalist.markdown(merged))
     generalist.plot(merged, HERE / "generalist.png")

@@ -1,5 +1,5 @@
 """Where LeaS policies leave eval_bridge's 0.30 m bridge: each policy rolls out from the scenario's
-seeded starts (`--starts`, yaw +-30 deg, 0.01-0.07 m/s) towards the target, once ending each path at
+seeded starts (`--starts`, drawn as `leas evaluate` draws them) towards the target, once ending each path at
 its own termination (as in training) and once rolling through it (as `leas evaluate` does). For the
 paths its termination ends within 0.5 m of the bridge's head (x 3.5-4.5 m, |y - 5| < 0.5 m), it
 prints the last pose kept: the root's offset from the bridge's centre line, its yaw to the bridge
@@ -22,23 +22,14 @@ import numpy as np
 
 from leas_jax import load_policy, load_terrain
 from leas_jax.env import condition, heightfield_from_terrain
-from leas_jax.steering.leas import rollout_batch, start_poses
+from leas_jax.eval.scenarios import cells_for, draw_starts
+from leas_jax.steering.leas import rollout_batch
 
 TERRAIN = "terrains/eval_bridge.toml"
 BRIDGE_Y = 5.0  # m, the bridge's centre line (x 4..7 m, 0.30 m wide, top at z = 0)
 BRIDGE_X = (4.0, 7.0)
 HEAD_X = (3.5, 4.5)
 STEPS = 900  # the evaluation's horizon on this route (`leas_horizon`, 2 x the walk at 0.18 m/s)
-
-
-def starts(terrain, field, n: int, seed: int):
-    """[n, 4] start poses and [n] speeds, drawn as the scenario's starts are (uniform region, yaw
-    +-30 deg from the target's bearing)."""
-    rng = np.random.default_rng(seed)
-    region, target = np.asarray(terrain.scenario.start_region), np.asarray(terrain.scenario.target)
-    xy = rng.uniform(region[0], region[1], size=(n, 2))
-    yaw = np.arctan2(target[1] - xy[:, 1], target[0] - xy[:, 0]) + np.radians(rng.uniform(-30, 30, n))
-    return start_poses(field, np.c_[xy, yaw], 1.0), rng.uniform(0.01, 0.07, n)
 
 
 def play(field, config) -> float:
@@ -61,8 +52,19 @@ def play(field, config) -> float:
 def row(label: str, run: str, n: int, seed: int) -> str:
     policy = load_policy(run)
     terrain = load_terrain(TERRAIN)
-    field = heightfield_from_terrain(terrain, policy.config.env)
-    poses, speeds = starts(terrain, field, n, seed)
+    env = policy.config.env
+    field = heightfield_from_terrain(terrain, env)
+    scenario = terrain.scenario
+    drawn = draw_starts(
+        scenario,
+        cells_for(terrain.name, scenario)[0],
+        n,
+        seed,
+        field,
+        env.nominal_root_height,
+        env.reachability,
+    )
+    poses, speeds = drawn.poses, drawn.speeds
     targets = np.tile(np.asarray(terrain.scenario.target, np.float32), (n, 1))
     ended = rollout_batch(policy, field, poses, targets, speeds, STEPS, stop_at_invalid=True)
     through = rollout_batch(policy, field, poses, targets, speeds, STEPS, stop_at_invalid=False)
@@ -86,7 +88,7 @@ def row(label: str, run: str, n: int, seed: int) -> str:
         off.append(np.abs(path[on, 1] - BRIDGE_Y).max())
         turn.append(np.degrees(np.abs(path[on, 3])).max())
     return (
-        f"| {label} | {play(field, policy.config.env):.2f} | {int(ended.reached.sum())} / {n} | {int(at_head.sum())} / {n} | "
+        f"| {label} | {play(field, env):.2f} | {int(ended.reached.sum())} / {n} | {int(at_head.sum())} / {n} | "
         f"{spread(offset[at_head])} | {spread(yaw[at_head])} | {spread(height[at_head])} | "
         f"{int(through.reached.sum())} / {n} | {spread(np.array(low))} | {spread(np.array(off))} | "
         f"{spread(np.array(turn))} |"
@@ -97,7 +99,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--policy", action="append", required=True, metavar="LABEL=RUN")
     parser.add_argument("--starts", type=int, default=30)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="the scenario's seed: `leas evaluate`'s starts")
     args = parser.parse_args()
     print(
         "| policy | its termination's play at mid-bridge (m) | reached, own termination | ended at the bridge's head | its offset from the centre "

@@ -1,5 +1,5 @@
 """Draws one policy's LeaS guides on some of `studies/pillar_fields.py`'s fields, rolled through
-the termination as `leas evaluate` rolls them (10 seeded starts per field, the evaluation's horizon):
+the termination as `leas evaluate` rolls them (its 10 seeded starts per field and its horizon):
 green guides reach the target, red ones do not; dotted circles mark 0.30 m (the trunk cylinder's
 radius) round each pillar; a dot every 2 s.
 
@@ -22,8 +22,9 @@ from pillar_fields import START, TARGET, pillar_boxes, pillar_field  # noqa: E40
 
 from leas_jax import load_policy, loads_terrain  # noqa: E402
 from leas_jax.env import heightfield_from_terrain  # noqa: E402
+from leas_jax.eval.scenarios import cells_for, draw_starts  # noqa: E402
 from leas_jax.steering.horizon import leas_horizon  # noqa: E402
-from leas_jax.steering.leas import rollout_batch, start_poses  # noqa: E402
+from leas_jax.steering.leas import rollout_batch  # noqa: E402
 
 STARTS = 10
 TRUNK_RADIUS = 0.30  # m
@@ -32,17 +33,19 @@ TRUNK_RADIUS = 0.30  # m
 def draw(ax, policy, seed: int) -> None:
     """Field `seed`'s pillars and the policy's guides from its seeded starts."""
     env = policy.config.env
-    field = heightfield_from_terrain(loads_terrain(pillar_field(seed, STARTS)), env)
-    rng = np.random.default_rng(seed)
-    xy = rng.uniform(np.subtract(START, 0.1), np.add(START, 0.1), size=(STARTS, 2))
-    yaw = np.arctan2(TARGET[1] - xy[:, 1], TARGET[0] - xy[:, 0]) + np.radians(rng.uniform(-30, 30, STARTS))
+    terrain = loads_terrain(pillar_field(seed, STARTS))
+    scenario = terrain.scenario
+    field = heightfield_from_terrain(terrain, env)
+    starts = draw_starts(
+        scenario, cells_for(terrain.name, scenario)[0], STARTS, scenario.seed, field, env.nominal_root_height
+    )
     steps = leas_horizon(START, np.array([TARGET]), env.target_speed, env.timestep, env.episode_length)
     result = rollout_batch(
         policy,
         field,
-        start_poses(field, np.c_[xy, yaw], env.nominal_root_height),
+        starts.poses,
         np.tile(TARGET, (STARTS, 1)),
-        rng.uniform(0.01, 0.07, STARTS),
+        starts.speeds,
         steps,
         stop_at_invalid=False,
     )
